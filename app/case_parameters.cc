@@ -1,0 +1,161 @@
+#include "app/case_parameters.h"
+
+#include "core/errors.h"
+
+#include <cmath>
+
+namespace tribo::app
+{
+  using dealii::Patterns::Bool;
+  using dealii::Patterns::Double;
+  using dealii::Patterns::Integer;
+  using dealii::Patterns::Selection;
+
+  void declare_case_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection("Simulation");
+    prm.declare_entry("Scene", "compaction", Selection("collision|compaction"),
+                      "What to simulate: 'collision' (two discs, Cao et al. 2011 Fig. 8) or "
+                      "'compaction' (a periodic layer of discs pressed between two rough walls).");
+    prm.declare_entry("Time step", "1e-9", Double(), "Time step h, s (> 0).");
+    prm.declare_entry("End time", "1e-6", Double(), "Simulated time, s (> 0).");
+    prm.declare_entry("Theta", "0.5", Double(0.5, 1.0),
+                      "Moreau-Jean theta, in [0.5, 1]: 0.5 is the midpoint rule, 1 is implicit Euler.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Contact law");
+    prm.declare_entry("Law", "IQS", Selection("IQS|ELAS"),
+                      "IQS: cohesive unilateral (inelastic quasi-shock), r_N + gamma >= 0, g >= 0, "
+                      "(r_N + gamma) g = 0. ELAS: cohesive elastic, r_N + gamma = max(0, -k g). "
+                      "r_N > 0 is compressive; see docs/laws.md.");
+    prm.declare_entry("Cohesion", "0", Double(), "Cohesion gamma, N/m (force per unit depth), >= 0.");
+    prm.declare_entry("Cohesion range", "0", Double(),
+                      "Distance d_w over which the cohesion acts, m, >= 0 (needed if Cohesion > 0).");
+    prm.declare_entry("Stiffness", "1e10", Double(),
+                      "ELAS normal stiffness k, N/m^2 (force per unit depth per metre of overlap), > 0.");
+    prm.declare_entry("Friction coefficient", "0", Double(),
+                      "Coulomb friction coefficient between discs, >= 0 (0: frictionless, as in the paper).");
+    prm.declare_entry("Detection distance", "0", Double(),
+                      "Pairs closer than this gap (m) enter the contact list; 0 picks a tenth of the "
+                      "smallest radius. Always at least the cohesion range.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Solver");
+    prm.declare_entry("Tolerance", "1e-4", Double(), "NLGS tolerance, > 0 (relative, see Norm).");
+    prm.declare_entry("Norm", "Quad", Selection("Quad|Maxm"),
+                      "Convergence norm of the established NSCD code: 'Quad' (mean-square) or "
+                      "'Maxm' (maximum over contacts).");
+    prm.declare_entry("Relaxation", "1", Double(), "Relaxation omega in (0, 1]: r = omega r_law + (1 - omega) r_old.");
+    prm.declare_entry("Check interval", "10", Integer(1), "Sweeps between convergence checks, >= 1.");
+    prm.declare_entry("Maximum iterations", "10000", Integer(1), "Maximum number of sweeps per step, >= 1.");
+    prm.declare_entry("Contact order", "fixed", Selection("fixed|random"),
+                      "Order of the local solves: 'fixed' (detection order) or 'random' (shuffled every sweep).");
+    prm.declare_entry("Seed", "1", Integer(0), "Seed of the random contact order.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Output");
+    prm.declare_entry("Statistics interval", "1", Integer(1), "Steps between rows of statistics.csv, >= 1.");
+    prm.declare_entry("Field interval", "0", Integer(0),
+                      "Steps between VTU snapshots in fields/; 0 writes only the first and the last.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Collision");
+    prm.declare_entry("Diameter", "1.2e-6", Double(), "Diameter of both discs, m (> 0).");
+    prm.declare_entry("Density", "7800", Double(), "Density, kg/m^3 (> 0).");
+    prm.declare_entry("Impact velocity", "2", Double(),
+                      "Relative normal velocity at t = 0, m/s: > 0 approaching, < 0 separating, not 0.");
+    prm.declare_entry("Initial gap", "1e-10", Double(), "Gap between the discs at t = 0, m (> -diameter/2).");
+    prm.declare_entry("Time step ratio", "0", Double(),
+                      "dt*/dt with dt* = sqrt(m_eff/k), >= 0; if > 0 it sets the time step and "
+                      "Simulation/Time step is ignored.");
+    prm.declare_entry("Stop when separated", "true", Bool(),
+                      "End the run once the discs have touched and are farther apart than the "
+                      "detection distance.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Compaction");
+    prm.declare_entry("Number of discs", "400", Integer(1), "Number of free discs, >= 1.");
+    prm.declare_entry("Mean diameter", "1.2e-6", Double(), "Mean disc diameter d, m (> 0).");
+    prm.declare_entry("Diameter spread", "0.2", Double(0, 0.99),
+                      "Relative half-width s of the uniform diameter distribution [d(1-s), d(1+s)].");
+    prm.declare_entry("Density", "7800", Double(), "Density of discs and walls, kg/m^3 (> 0).");
+    prm.declare_entry("Length", "2.5e-5", Double(), "Period along x, m (> 0).");
+    prm.declare_entry("Pressure", "1e8", Double(), "Pressure P on the upper wall, Pa (> 0); force P L per unit depth.");
+    prm.declare_entry("Pressure ramp steps", "200", Integer(0), "Steps over which the pressure rises linearly from 0.");
+    prm.declare_entry("Upper body thickness", "1.5e-4", Double(),
+                      "Thickness of the first body the upper wall stands for, m (> 0): its mass is "
+                      "density * thickness * L.");
+    prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
+    prm.leave_subsection();
+  }
+
+  CaseParameters read_case_parameters(const ParameterFile &f)
+  {
+    const auto positive     = [](double v) { return v > 0 && std::isfinite(v); };
+    const auto non_negative = [](double v) { return v >= 0 && std::isfinite(v); };
+
+    CaseParameters p;
+    p.scene     = f.get("Simulation/Scene");
+    p.time_step = f.get_checked("Simulation/Time step", positive, "a positive time step in s");
+    p.end_time  = f.get_checked("Simulation/End time", positive, "a positive end time in s");
+    p.theta     = f.get_double("Simulation/Theta");
+
+    p.law.type = f.get("Contact law/Law") == "IQS" ? dem::ContactLaw::Type::iqs : dem::ContactLaw::Type::elas;
+    p.law.cohesion = f.get_checked("Contact law/Cohesion", non_negative, "a cohesion >= 0 in N/m");
+    p.law.cohesion_range =
+      f.get_checked("Contact law/Cohesion range", non_negative, "a distance >= 0 in m");
+    if (p.law.cohesion > 0 && p.law.cohesion_range == 0)
+      f.fail("Contact law/Cohesion range", "a positive range in m, since Contact law/Cohesion > 0");
+    p.law.stiffness = f.get_checked("Contact law/Stiffness", positive, "a positive stiffness in N/m^2");
+    p.law.friction  = f.get_checked("Contact law/Friction coefficient", non_negative, "a coefficient >= 0");
+    p.detection_distance =
+      f.get_checked("Contact law/Detection distance", non_negative, "a distance >= 0 in m");
+
+    p.solver.tolerance = f.get_checked("Solver/Tolerance", positive, "a positive tolerance");
+    p.solver.norm = f.get("Solver/Norm") == "Quad" ? dem::NlgsParameters::Norm::quad : dem::NlgsParameters::Norm::maxm;
+    p.solver.relaxation = f.get_checked("Solver/Relaxation", [](double v) { return v > 0 && v <= 1; },
+                                        "a relaxation in (0, 1]");
+    p.solver.check_interval = f.get_integer("Solver/Check interval");
+    p.solver.max_iterations = f.get_integer("Solver/Maximum iterations");
+    p.solver.random_order   = f.get("Solver/Contact order") == "random";
+    p.solver.seed           = f.get_integer("Solver/Seed");
+
+    p.statistics_interval = f.get_integer("Output/Statistics interval");
+    p.field_interval      = f.get_integer("Output/Field interval");
+
+    auto &c = p.collision;
+    if (p.scene == "collision")
+      {
+        c.diameter = f.get_checked("Collision/Diameter", positive, "a positive diameter in m");
+        c.density  = f.get_checked("Collision/Density", positive, "a positive density in kg/m^3");
+        c.impact_velocity = f.get_checked("Collision/Impact velocity",
+                                          [](double v) { return v != 0 && std::isfinite(v); },
+                                          "a non-zero velocity in m/s");
+        c.initial_gap = f.get_checked("Collision/Initial gap",
+                                      [&](double v) { return v > -0.5 * c.diameter; },
+                                      "a gap in m larger than minus half the diameter");
+        c.time_step_ratio = f.get_checked("Collision/Time step ratio", non_negative, "a ratio >= 0");
+        c.stop_when_separated = f.get_bool("Collision/Stop when separated");
+      }
+
+    auto &k = p.compaction;
+    if (p.scene == "compaction")
+      {
+        k.n_discs = f.get_integer("Compaction/Number of discs");
+        k.mean_diameter = f.get_checked("Compaction/Mean diameter", positive, "a positive diameter in m");
+        k.diameter_spread = f.get_double("Compaction/Diameter spread");
+        k.density  = f.get_checked("Compaction/Density", positive, "a positive density in kg/m^3");
+        k.length   = f.get_checked("Compaction/Length", positive, "a positive length in m");
+        const double d_max = k.mean_diameter * (1 + k.diameter_spread);
+        if (k.length < 4 * d_max)
+          f.fail("Compaction/Length", "a length of at least 4 largest diameters (" +
+                                        std::to_string(4 * d_max) + " m)");
+        k.pressure = f.get_checked("Compaction/Pressure", positive, "a positive pressure in Pa");
+        k.ramp_steps = f.get_integer("Compaction/Pressure ramp steps");
+        k.upper_body_thickness =
+          f.get_checked("Compaction/Upper body thickness", positive, "a positive thickness in m");
+        k.seed = f.get_integer("Compaction/Seed");
+      }
+    return p;
+  }
+} // namespace tribo::app

@@ -1,0 +1,60 @@
+#pragma once
+/// @file The parameters of a case: declaration (with patterns, defaults and
+/// units) and validated reading into plain structs.
+
+#include "core/parameter_file.h"
+#include "dem/contact_law.h"
+#include "dem/nlgs.h"
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <string>
+
+namespace tribo::app
+{
+  /// Two discs colliding head-on (Cao et al. 2011, Fig. 8).
+  struct CollisionParameters
+  {
+    double diameter;         ///< m, both discs
+    double density;          ///< kg/m^3
+    double impact_velocity;  ///< relative normal velocity at t = 0, m/s (> 0 approaching)
+    double initial_gap;      ///< m
+    double time_step_ratio;  ///< dt*/dt with dt* = sqrt(m_eff/k); 0: use Simulation/Time step
+    bool   stop_when_separated;
+  };
+
+  /// A layer of discs compacted between two rough walls, periodic in x.
+  struct CompactionParameters
+  {
+    unsigned int n_discs;
+    double       mean_diameter;   ///< m
+    double       diameter_spread; ///< relative half-width: d in [d(1-s), d(1+s)]
+    double       density;         ///< kg/m^3
+    double       length;          ///< period along x, m
+    double       pressure;        ///< Pa, applied as P L (N/m) on the upper wall
+    unsigned int ramp_steps;      ///< steps over which P grows linearly from 0
+    double       upper_body_thickness; ///< m: upper wall mass = density * thickness * L
+    unsigned int seed;
+  };
+
+  struct CaseParameters
+  {
+    std::string scene;
+    double      time_step;
+    double      end_time;
+    double      theta;
+    dem::ContactLaw     law;
+    double              detection_distance; ///< m; 0: a tenth of the smallest radius
+    dem::NlgsParameters solver;
+    unsigned int statistics_interval; ///< steps between rows of statistics.csv
+    unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)
+    CollisionParameters  collision;
+    CompactionParameters compaction;
+  };
+
+  /// Declare every entry of a case file.
+  void declare_case_parameters(dealii::ParameterHandler &prm);
+
+  /// Read and check a parsed case; InputError names the entry and what was expected.
+  CaseParameters read_case_parameters(const ParameterFile &file);
+} // namespace tribo::app

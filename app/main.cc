@@ -1,0 +1,91 @@
+// tribo: the command-line front end.
+#include "app/run.h"
+#include "core/errors.h"
+
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace
+{
+  const char *usage = R"(tribo: third-body tribology simulations (NSCD rigid discs; more first-body models to come)
+
+Usage:
+  tribo run CASE.prm [--output DIR] [--set "Subsection/Entry=value" ...] [--quiet]
+      Run a case; outputs go to DIR (default output/<case name>), see docs/outputs.md.
+  tribo check CASE.prm [--set ...]
+      Read and validate a case without running it.
+  tribo params
+      Print every parameter with its default, allowed values and unit: a case to start from.
+  tribo --help | --version
+
+Exit codes: 0 success, 1 the run failed, 2 bad input, 128+N interrupted by signal N.
+)";
+
+  [[noreturn]] void usage_error(const std::string &message)
+  {
+    throw tribo::InputError(message + " (see `tribo --help`)");
+  }
+} // namespace
+
+int main(int argc, char **argv)
+{
+  try
+    {
+      std::vector<std::string> args(argv + 1, argv + argc);
+      if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help")
+        {
+          std::cout << usage;
+          return args.empty() ? tribo::exit_input_error : tribo::exit_ok;
+        }
+      if (args[0] == "--version")
+        {
+          std::cout << "tribo " << TRIBO_VERSION << std::endl;
+          return tribo::exit_ok;
+        }
+      if (args[0] == "params")
+        {
+          if (args.size() > 1)
+            usage_error("'tribo params' takes no arguments");
+          std::cout << tribo::app::parameter_reference();
+          return tribo::exit_ok;
+        }
+      if (args[0] != "run" && args[0] != "check")
+        usage_error("unknown command '" + args[0] + "'");
+
+      tribo::app::RunOptions o;
+      o.check_only = args[0] == "check";
+      for (std::size_t i = 1; i < args.size(); ++i)
+        {
+          const std::string &a = args[i];
+          if (a == "--output" || a == "--set")
+            {
+              if (i + 1 >= args.size())
+                usage_error(a + " needs a value");
+              (a == "--output" ? o.output_dir : o.overrides.emplace_back()) = args[++i];
+            }
+          else if (a == "--quiet")
+            o.quiet = true;
+          else if (!a.empty() && a[0] == '-')
+            usage_error("unknown option '" + a + "'");
+          else if (o.case_file.empty())
+            o.case_file = a;
+          else
+            usage_error("more than one case file ('" + o.case_file + "', '" + a + "')");
+        }
+      if (o.case_file.empty())
+        usage_error("'tribo " + args[0] + "' needs a case file");
+      return tribo::app::run_case(o);
+    }
+  catch (const tribo::InputError &e)
+    {
+      std::cerr << "error: " << e.what() << std::endl;
+      return tribo::exit_input_error;
+    }
+  catch (const std::exception &e)
+    {
+      std::cerr << "error: " << e.what() << std::endl;
+      return tribo::exit_run_error;
+    }
+}

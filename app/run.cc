@@ -1,0 +1,321 @@
+#include "app/run.h"
+
+#include "app/case_parameters.h"
+#include "app/scene.h"
+#include "core/errors.h"
+#include "core/output.h"
+#include "core/parameter_file.h"
+#include "core/run_control.h"
+
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
+
+#include <cctype>
+#include <chrono>
+#include <iostream>
+#include <map>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+namespace tribo::app
+{
+  namespace fs = std::filesystem;
+
+  namespace
+  {
+    const std::vector<std::string> common_columns = {
+      "time", "step", "n_contacts", "n_active_contacts", "nlgs_iterations", "nlgs_residual",
+      "nlgs_converged", "epsilon", "max_overlap", "kinetic_energy", "power_external",
+      "power_free", "power_contacts"};
+
+    /// Undo ParameterHandler's name mangling ("_20" for a blank, ...).
+    std::string demangle(const std::string &s)
+    {
+      std::string out;
+      for (std::size_t i = 0; i < s.size(); ++i)
+        if (s[i] == '_' && i + 2 < s.size() + 0 && std::isxdigit(s[i + 1]) && std::isxdigit(s[i + 2]))
+          {
+            out += static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+          }
+        else
+          out += s[i];
+      return out;
+    }
+
+    /// Every resolved entry as "Subsection/Entry" -> value.
+    void collect(const boost::property_tree::ptree &tree, const std::string &prefix,
+                 std::map<std::string, std::string> &out)
+    {
+      for (const auto &[key, child] : tree)
+        {
+          if (child.get_optional<std::string>("value"))
+            out[prefix + demangle(key)] = child.get<std::string>("value");
+          else if (!child.empty())
+            collect(child, prefix + demangle(key) + "/", out);
+        }
+    }
+
+    void write_fields(FieldWriter &writer, double t, const dem::ParticleSystem &s,
+                      const dem::MoreauJean &mj, double h)
+    {
+      DiscField discs;
+      for (std::size_t d = 0; d < s.discs.size(); ++d)
+        {
+          const auto &b   = s.bodies[s.discs[d].body];
+          const auto  x   = s.wrap(s.disc_centre(d));
+          const auto  arm = dem::rotate(s.discs[d].offset, b.angle);
+          discs.x.push_back(x.x());
+          discs.y.push_back(x.y());
+          discs.radius.push_back(s.discs[d].radius);
+          discs.vx.push_back(b.velocity.x() - b.spin * arm.y());
+          discs.vy.push_back(b.velocity.y() + b.spin * arm.x());
+          discs.spin.push_back(b.spin);
+          discs.body.push_back(s.discs[d].body);
+        }
+      ContactField contacts;
+      for (const auto &c : mj.contacts())
+        {
+          if (c.r.x() == 0 && c.r.y() == 0)
+            continue;
+          const auto x0 = s.wrap(s.disc_centre(c.disc[0]));
+          contacts.x0.push_back(x0.x());
+          contacts.y0.push_back(x0.y());
+          contacts.x1.push_back(x0.x() + c.branch.x());
+          contacts.y1.push_back(x0.y() + c.branch.y());
+          contacts.normal_force.push_back(c.r.x() / h);
+          contacts.tangential_force.push_back(c.r.y() / h);
+          contacts.gap.push_back(c.gap);
+        }
+      writer.write(t, discs, contacts);
+    }
+  } // namespace
+
+  std::string parameter_reference()
+  {
+    dealii::ParameterHandler prm;
+    declare_case_parameters(prm);
+    std::ostringstream json;
+    prm.print_parameters(json, dealii::ParameterHandler::JSON);
+    boost::property_tree::ptree tree;
+    std::istringstream          is(json.str());
+    boost::property_tree::read_json(is, tree);
+
+    // A case file with every entry at its default, documented, and its allowed values.
+    std::ostringstream os;
+    os << "# tribo parameters: every entry with its default; units in the text.\n"
+       << "# Copy this file, keep the entries you change.\n";
+    for (const auto &[section, entries] : tree)
+      {
+        os << "\nsubsection " << demangle(section) << "\n";
+        for (const auto &[name, entry] : entries)
+          {
+            os << "  # " << entry.get<std::string>("documentation") << "\n"
+               << "  # Allowed: " << entry.get<std::string>("pattern_description") << "\n"
+               << "  set " << demangle(name) << " = " << entry.get<std::string>("default_value")
+               << "\n\n";
+          }
+        os << "end\n";
+      }
+    return os.str();
+  }
+
+  int run_case(const RunOptions &o)
+  {
+    dealii::ParameterHandler prm;
+    declare_case_parameters(prm);
+    ParameterFile file(prm);
+    file.parse(o.case_file);
+    for (const auto &s : o.overrides)
+      file.set(s);
+    const CaseParameters p = read_case_parameters(file);
+    if (o.check_only)
+      {
+        std::cout << o.case_file << ": OK (scene " << p.scene << ")" << std::endl;
+        return exit_ok;
+      }
+
+    // The output directory, emptied of a previous run's files.
+    const fs::path dir = o.output_dir.empty() ? fs::path("output") / fs::path(o.case_file).stem()
+                                              : fs::path(o.output_dir);
+    try
+      {
+        fs::create_directories(dir / "fields");
+        for (const char *name : {"statistics.csv", "results.h5", "summary.json", "log.txt",
+                                 "original.prm", "parameters.prm"})
+          fs::remove(dir / name);
+        for (const auto &entry : fs::directory_iterator(dir / "fields"))
+          fs::remove(entry.path());
+      }
+    catch (const fs::filesystem_error &e)
+      {
+        throw InputError("--output " + dir.string() + ": cannot prepare the directory (" +
+                         e.code().message() + ")");
+      }
+
+    JsonObject summary;
+    summary.set("status", "running");
+    summary.set("case", o.case_file);
+    atomic_write((dir / "summary.json").string(), summary.to_string());
+    atomic_write((dir / "original.prm").string(), file.original_text());
+    {
+      std::ostringstream os;
+      prm.print_parameters(os, dealii::ParameterHandler::PRM);
+      atomic_write((dir / "parameters.prm").string(), os.str());
+    }
+    std::map<std::string, std::string> resolved;
+    {
+      std::ostringstream os;
+      prm.print_parameters(os, dealii::ParameterHandler::JSON);
+      boost::property_tree::ptree tree;
+      std::istringstream          is(os.str());
+      boost::property_tree::read_json(is, tree);
+      collect(tree, "", resolved);
+    }
+
+    Log log;
+    log.open((dir / "log.txt").string(), !o.quiet);
+    log("tribo run " + o.case_file + " -> " + dir.string());
+
+    install_stop_handlers();
+    const auto wall_start = std::chrono::steady_clock::now();
+
+    std::unique_ptr<Scene> scene = make_scene(p);
+    dem::ParticleSystem    system;
+    scene->build(system);
+    const double h        = scene->time_step(system);
+    const double distance = p.detection_distance > 0 ? p.detection_distance : 0.1 * system.min_radius();
+    dem::MoreauJean mj(p.theta, p.law, p.solver, distance);
+    const unsigned long n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
+    {
+      std::ostringstream os;
+      os << "scene " << p.scene << ": " << system.bodies.size() << " bodies, " << system.discs.size()
+         << " discs; h = " << h << " s, " << n_steps << " steps, detection distance " << mj.detection_distance() << " m";
+      log(os.str());
+    }
+
+    std::vector<std::string> columns = common_columns;
+    for (const auto &c : scene->columns())
+      columns.push_back(c);
+    TimeSeries  stats(columns);
+    FieldWriter fields((dir / "fields").string());
+    write_fields(fields, 0, system, mj, h);
+
+    std::string   status = "complete", failure;
+    unsigned long step = 0, total_iterations = 0, non_converged = 0, max_iterations = 0;
+    double        worst_overlap = 0, t = 0, max_residual = 0;
+    ProgressLine  progress(n_steps * h, !o.quiet);
+    auto          last_flush = std::chrono::steady_clock::now();
+    try
+      {
+        for (; step < n_steps; )
+          {
+            if (stop_requested())
+              {
+                status = "interrupted";
+                break;
+              }
+            scene->before_step(system, step);
+            const dem::StepReport r = mj.step(system, h);
+            ++step;
+            t = step * h;
+            total_iterations += r.solver.iterations;
+            max_iterations = std::max<unsigned long>(max_iterations, r.solver.iterations);
+            max_residual   = std::max(max_residual, r.solver.residual);
+            worst_overlap  = std::max(worst_overlap, r.max_overlap);
+            if (!r.solver.converged && ++non_converged <= 10)
+              {
+                std::ostringstream os;
+                os << "warning: step " << step << " (t = " << t << " s): NLGS did not converge in "
+                   << r.solver.iterations << " sweeps, residual " << r.solver.residual
+                   << (non_converged == 10 ? " (further warnings only counted)" : "");
+                progress.finish();
+                log(os.str());
+              }
+            const std::vector<double> extra = scene->measure(system, mj, r);
+            const bool last = step == n_steps || scene->finished();
+            if (step % p.statistics_interval == 0 || last)
+              {
+                std::vector<double> row = {t, double(step), double(r.n_contacts), double(r.n_active),
+                                           double(r.solver.iterations), r.solver.residual,
+                                           r.solver.converged ? 1.0 : 0.0, r.epsilon, r.max_overlap,
+                                           r.kinetic_energy, r.power_external, r.power_free,
+                                           r.power_contacts};
+                row.insert(row.end(), extra.begin(), extra.end());
+                stats.add_row(row);
+              }
+            if (p.field_interval > 0 && step % p.field_interval == 0 && !last)
+              write_fields(fields, t, system, mj, h);
+            const auto now = std::chrono::steady_clock::now();
+            if (std::chrono::duration<double>(now - last_flush).count() > 10)
+              {
+                atomic_write((dir / "statistics.csv").string(), stats.to_csv());
+                last_flush = now;
+              }
+            progress.update(t, step);
+            if (scene->finished())
+              break;
+          }
+      }
+    catch (const RunError &e)
+      {
+        status  = "failed";
+        failure = e.what();
+      }
+    progress.finish();
+    write_fields(fields, t, system, mj, h);
+
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    summary.set("status", status);
+    if (!failure.empty())
+      summary.set("error", failure);
+    if (status == "interrupted")
+      summary.set("signal", long(stop_requested()));
+    summary.set("scene", p.scene);
+    summary.set("time_step", h);
+    summary.set("steps", long(step));
+    summary.set("steps_planned", long(n_steps));
+    summary.set("simulated_time", t);
+    summary.set("wall_time", wall);
+    summary.set("nlgs_iterations_total", long(total_iterations));
+    summary.set("nlgs_iterations_mean", step ? double(total_iterations) / step : 0.0);
+    summary.set("nlgs_iterations_max", long(max_iterations));
+    summary.set("nlgs_residual_max", max_residual);
+    summary.set("nlgs_non_converged_steps", long(non_converged));
+    summary.set("max_overlap", worst_overlap);
+    summary.set("max_overlap_over_min_radius", worst_overlap / system.min_radius());
+    summary.set("n_bodies", long(system.bodies.size()));
+    summary.set("n_discs", long(system.discs.size()));
+    summary.set("n_field_snapshots", long(fields.n_snapshots()));
+    JsonObject scene_results;
+    if (!stats.rows().empty())
+      scene->summarize(system, stats, scene_results);
+    summary.set("results", scene_results);
+
+    std::map<std::string, double> scalars = {{"time_step", h}, {"steps", double(step)},
+                                             {"simulated_time", t}, {"wall_time", wall},
+                                             {"complete", status == "complete" ? 1.0 : 0.0}};
+    atomic_write((dir / "statistics.csv").string(), stats.to_csv());
+    write_results_h5((dir / "results.h5").string(), stats, resolved, scalars);
+    atomic_write((dir / "summary.json").string(), summary.to_string());
+
+    std::ostringstream os;
+    os << "status " << status << ": " << step << " steps in " << wall << " s, "
+       << (step ? double(total_iterations) / step : 0.0) << " NLGS sweeps per step, "
+       << non_converged << " steps not converged, worst overlap " << worst_overlap << " m";
+    log(os.str());
+    if (status == "failed")
+      {
+        log("error: " + failure);
+        return exit_run_error;
+      }
+    if (status == "interrupted")
+      {
+        log("interrupted by signal " + std::to_string(stop_requested()) +
+            ": outputs hold the steps done so far");
+        return 128 + stop_requested();
+      }
+    return exit_ok;
+  }
+} // namespace tribo::app

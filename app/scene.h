@@ -1,0 +1,42 @@
+#pragma once
+/// @file A scene builds the bodies of a case, drives them over time, and adds
+/// its own columns to statistics.csv and entries to summary.json.
+
+#include "app/case_parameters.h"
+#include "core/output.h"
+#include "dem/moreau_jean.h"
+#include "dem/particle_system.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tribo::app
+{
+  class Scene
+  {
+  public:
+    virtual ~Scene() = default;
+    /// Create the bodies.
+    virtual void build(dem::ParticleSystem &system) = 0;
+    /// The time step to use (the case's, unless the scene derives it).
+    virtual double time_step(const dem::ParticleSystem &) const { return prm.time_step; }
+    /// Adjust loads before step @p step (e.g. a pressure ramp).
+    virtual void before_step(dem::ParticleSystem &, unsigned long /*step*/) {}
+    /// Names of the scene's own statistics columns and their values after a step.
+    virtual std::vector<std::string> columns() const { return {}; }
+    virtual std::vector<double> measure(const dem::ParticleSystem &, const dem::MoreauJean &,
+                                        const dem::StepReport &) { return {}; }
+    /// True when the scene's event is over (the run then ends before End time).
+    virtual bool finished() const { return false; }
+    /// Scene results for summary.json, from the state and the statistics.
+    virtual void summarize(const dem::ParticleSystem &, const TimeSeries &, JsonObject &) const {}
+
+  protected:
+    explicit Scene(const CaseParameters &p) : prm(p) {}
+    CaseParameters prm;
+  };
+
+  /// The scene named by Simulation/Scene.
+  std::unique_ptr<Scene> make_scene(const CaseParameters &p);
+} // namespace tribo::app

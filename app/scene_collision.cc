@@ -1,0 +1,92 @@
+// Two discs in a head-on collision along x (Cao et al. 2011, Fig. 8).
+#include "app/scene.h"
+
+#include <cmath>
+
+namespace tribo::app
+{
+  namespace
+  {
+    /// Disc 0 moves at +v/2 towards disc 1 at -v/2 (v = Impact velocity).
+    class CollisionScene : public Scene
+    {
+    public:
+      explicit CollisionScene(const CaseParameters &p) : Scene(p) {}
+
+      void build(dem::ParticleSystem &s) override
+      {
+        const auto  &c = prm.collision;
+        const double r = 0.5 * c.diameter;
+        s.add_disc({0, 0}, r, c.density);
+        s.add_disc({2 * r + c.initial_gap, 0}, r, c.density);
+        s.bodies[0].velocity = {0.5 * c.impact_velocity, 0};
+        s.bodies[1].velocity = {-0.5 * c.impact_velocity, 0};
+        m_eff        = 0.5 * s.bodies[0].mass;
+        energy_start = s.kinetic_energy();
+      }
+
+      /// dt*/ratio with dt* = sqrt(m_eff/k) when a ratio is given.
+      double time_step(const dem::ParticleSystem &) const override
+      {
+        if (prm.collision.time_step_ratio > 0)
+          return std::sqrt(m_eff / prm.law.stiffness) / prm.collision.time_step_ratio;
+        return prm.time_step;
+      }
+
+      std::vector<std::string> columns() const override
+      {
+        return {"gap", "relative_normal_velocity", "normal_force", "energy_change"};
+      }
+
+      std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
+                                  const dem::StepReport &) override
+      {
+        const double gap = (s.bodies[1].position - s.bodies[0].position).norm() -
+                           s.discs[0].radius - s.discs[1].radius;
+        const double vrel = s.bodies[1].velocity.x() - s.bodies[0].velocity.x();
+        double       fn   = 0;
+        if (!mj.contacts().empty())
+          fn = mj.contact_force()[1].x();
+        if (fn != 0)
+          touched = true;
+        if (touched && fn == 0 && gap > mj.detection_distance())
+          separated = true;
+        if (fn != 0)
+          ++contact_steps;
+        last_gap = gap;
+        return {gap, vrel, fn, s.kinetic_energy() / energy_start - 1};
+      }
+
+      bool finished() const override { return prm.collision.stop_when_separated && separated; }
+
+      void summarize(const dem::ParticleSystem &s, const TimeSeries &, JsonObject &j) const override
+      {
+        const double dt_star = std::sqrt(m_eff / prm.law.stiffness);
+        const double v_in    = prm.collision.impact_velocity;
+        const double v_out   = s.bodies[1].velocity.x() - s.bodies[0].velocity.x();
+        j.set("effective_mass", m_eff);
+        j.set("dt_star", dt_star);
+        j.set("time_step_ratio", dt_star / time_step(s));
+        j.set("escape_velocity", std::sqrt(2 * prm.law.cohesion * prm.law.cohesion_range / m_eff));
+        j.set("separated", separated);
+        j.set("kinetic_energy_initial", energy_start);
+        j.set("kinetic_energy_final", s.kinetic_energy());
+        j.set("energy_loss", 1 - s.kinetic_energy() / energy_start);
+        j.set("restitution_coefficient", v_in > 0 ? v_out / v_in : -v_out / v_in);
+        j.set("final_gap", last_gap);
+        j.set("contact_duration", contact_steps * time_step(s));
+        j.set("elastic_contact_duration", M_PI * dt_star);
+      }
+
+    private:
+      double        m_eff = 0, energy_start = 0, last_gap = 0;
+      unsigned long contact_steps = 0;
+      bool   touched = false, separated = false;
+    };
+  } // namespace
+
+  std::unique_ptr<Scene> make_collision_scene(const CaseParameters &p)
+  {
+    return std::make_unique<CollisionScene>(p);
+  }
+} // namespace tribo::app

@@ -1,0 +1,32 @@
+#pragma once
+/// @file Errors reported to users and the exit codes of `tribo`.
+
+#include <stdexcept>
+#include <string>
+
+namespace tribo
+{
+  /// Wrong user input (parameter file, command line). The message names the
+  /// file, the entry or line, and what was expected; `tribo` prints it alone
+  /// (no stack) and exits with ExitCode::input_error.
+  class InputError : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
+
+  /// A run that cannot go on (solver blow-up, NaN, I/O failure).
+  class RunError : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
+
+  /// Exit codes of `tribo`; an interrupted run exits with 128 + signal number.
+  enum ExitCode : int
+  {
+    exit_ok          = 0,
+    exit_run_error   = 1,
+    exit_input_error = 2
+  };
+} // namespace tribo

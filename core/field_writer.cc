@@ -1,0 +1,99 @@
+// VTU snapshots of discs and contacts through deal.II's DataOutBase, with .pvd indices.
+#include "core/errors.h"
+#include "core/output.h"
+
+#include <deal.II/base/data_out_base.h>
+
+#include <cstdio>
+#include <sstream>
+
+namespace tribo
+{
+  namespace
+  {
+    using Interpretation = dealii::DataComponentInterpretation::DataComponentInterpretation;
+    using Ranges         = std::vector<std::tuple<unsigned int, unsigned int, std::string, Interpretation>>;
+
+    template <typename Patches>
+    std::string vtu_text_of(const Patches &patches, const std::vector<std::string> &names,
+                            const Ranges &ranges)
+    {
+      dealii::DataOutBase::VtkFlags flags;
+      flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
+      std::ostringstream os;
+      dealii::DataOutBase::write_vtu(patches, names, ranges, flags, os);
+      return os.str();
+    }
+
+    std::string numbered(const std::string &stem, std::size_t n)
+    {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "_%05zu.vtu", n);
+      return stem + buf;
+    }
+
+    std::string pvd_text(const std::vector<std::pair<double, std::string>> &files)
+    {
+      std::ostringstream os;
+      dealii::DataOutBase::write_pvd_record(os, files);
+      return os.str();
+    }
+  } // namespace
+
+  FieldWriter::FieldWriter(std::string directory)
+    : dir(std::move(directory))
+  {}
+
+  void FieldWriter::write(double t, const DiscField &discs, const ContactField &contacts)
+  {
+    const std::size_t n = times.size();
+
+    // Discs: one vertex patch per disc; data rows radius, vx, vy, spin, body.
+    std::vector<dealii::DataOutBase::Patch<0, 2>> disc_patches(discs.x.size());
+    for (std::size_t i = 0; i < disc_patches.size(); ++i)
+      {
+        auto &p       = disc_patches[i];
+        p.vertices[0] = dealii::Point<2>(discs.x[i], discs.y[i]);
+        p.patch_index = i;
+        p.data.reinit(5, 1);
+        p.data(0, 0) = discs.radius[i];
+        p.data(1, 0) = discs.vx[i];
+        p.data(2, 0) = discs.vy[i];
+        p.data(3, 0) = discs.spin[i];
+        p.data(4, 0) = discs.body[i];
+      }
+    const Ranges disc_ranges = {
+      {1, 2, "velocity", dealii::DataComponentInterpretation::component_is_part_of_vector}};
+
+    // Contacts: one line patch per contact, from centre to centre.
+    std::vector<dealii::DataOutBase::Patch<1, 2>> contact_patches(contacts.x0.size());
+    for (std::size_t i = 0; i < contact_patches.size(); ++i)
+      {
+        auto &p       = contact_patches[i];
+        p.vertices[0] = dealii::Point<2>(contacts.x0[i], contacts.y0[i]);
+        p.vertices[1] = dealii::Point<2>(contacts.x1[i], contacts.y1[i]);
+        p.patch_index = i;
+        p.data.reinit(3, 2);
+        for (unsigned int v = 0; v < 2; ++v)
+          {
+            p.data(0, v) = contacts.normal_force[i];
+            p.data(1, v) = contacts.tangential_force[i];
+            p.data(2, v) = contacts.gap[i];
+          }
+      }
+
+    const std::string disc_file    = numbered("discs", n);
+    const std::string contact_file = numbered("contacts", n);
+    atomic_write(dir + "/" + disc_file,
+                 vtu_text_of(disc_patches, {"radius", "velocity", "velocity", "spin", "body"},
+                             disc_ranges));
+    atomic_write(dir + "/" + contact_file,
+                 vtu_text_of(contact_patches, {"normal_force", "tangential_force", "gap"}, {}));
+
+    times.push_back(t);
+    disc_files.emplace_back(t, disc_file);
+    contact_files.emplace_back(t, contact_file);
+    atomic_write(dir + "/discs.pvd", pvd_text(disc_files));
+    atomic_write(dir + "/contacts.pvd", pvd_text(contact_files));
+  }
+} // namespace tribo

@@ -1,0 +1,103 @@
+#pragma once
+/// @file Output files of a run: atomic writes, the statistics time series
+/// (CSV and HDF5), summary.json, the log, and the ParaView field files.
+/// Every file is written to "NAME.tmp" and renamed, so a file that exists is
+/// complete as far as it goes (see docs/outputs.md).
+
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace tribo
+{
+  /// Write @p content to @p path atomically (temporary file, then rename).
+  void atomic_write(const std::string &path, const std::string &content);
+
+  /// A table of named numeric columns, one row per output step.
+  class TimeSeries
+  {
+  public:
+    explicit TimeSeries(std::vector<std::string> columns = {});
+    void add_row(const std::vector<double> &row);
+    const std::vector<std::string> &columns() const { return names; }
+    const std::vector<std::vector<double>> &rows() const { return data; }
+    /// Column @p name as a vector (InputError-free: throws std::out_of_range).
+    std::vector<double> column(const std::string &name) const;
+    /// CSV text: a header of the column names, then full-precision rows.
+    std::string to_csv() const;
+
+  private:
+    std::vector<std::string>         names;
+    std::vector<std::vector<double>> data;
+  };
+
+  /// An ordered JSON object of scalars, strings and nested objects.
+  class JsonObject
+  {
+  public:
+    void set(const std::string &key, double value);
+    void set(const std::string &key, long value);
+    void set(const std::string &key, const std::string &value);
+    void set(const std::string &key, const char *value) { set(key, std::string(value)); }
+    void set(const std::string &key, bool value);
+    void set(const std::string &key, const JsonObject &value);
+    std::string to_string(unsigned int indent = 0) const;
+
+  private:
+    struct Raw { std::string text; };
+    void put(const std::string &key, std::string json_text);
+    std::vector<std::pair<std::string, std::string>> items;
+  };
+
+  /// Messages of a run: to log.txt (always) and to the terminal (unless quiet).
+  class Log
+  {
+  public:
+    Log() = default;
+    void open(const std::string &path, bool echo_to_terminal);
+    void operator()(const std::string &message);
+
+  private:
+    std::ofstream file;
+    bool          echo = true;
+  };
+
+  /// Write results.h5 (atomically): group "statistics" with one dataset per
+  /// column, group "parameters" with every resolved entry as a string
+  /// attribute (keyed by its path), and @p scalars as attributes of the root.
+  void write_results_h5(const std::string &path, const TimeSeries &statistics,
+                        const std::map<std::string, std::string> &parameters,
+                        const std::map<std::string, double> &scalars);
+
+  /// Point data for a VTU file of discs (one vertex per disc).
+  struct DiscField
+  {
+    std::vector<double> x, y, radius, vx, vy, spin, body;
+  };
+
+  /// Line data for a VTU file of contacts (one segment per contact, centre to centre).
+  struct ContactField
+  {
+    std::vector<double> x0, y0, x1, y1, normal_force, tangential_force, gap;
+  };
+
+  /// The fields/ directory: numbered VTU snapshots and their .pvd indices.
+  class FieldWriter
+  {
+  public:
+    explicit FieldWriter(std::string directory = "");
+    /// Write discs_NNNNN.vtu and contacts_NNNNN.vtu for time @p t and rewrite
+    /// discs.pvd and contacts.pvd.
+    void write(double t, const DiscField &discs, const ContactField &contacts);
+    unsigned int n_snapshots() const { return static_cast<unsigned int>(times.size()); }
+
+  private:
+    std::string                                 dir;
+    std::vector<std::pair<double, std::string>> disc_files, contact_files;
+    std::vector<double>                         times;
+  };
+} // namespace tribo

@@ -1,0 +1,206 @@
+#include "core/parameter_file.h"
+
+#include "core/errors.h"
+
+#include <deal.II/base/exceptions.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace tribo
+{
+  namespace
+  {
+    /// deal.II's own explanation of an exception, without its source location.
+    std::string describe(const dealii::ExceptionBase &e)
+    {
+      std::ostringstream os;
+      e.print_info(os);
+      std::string s = os.str();
+      // Collapse deal.II's line breaks and indentation into one line.
+      s = std::regex_replace(s, std::regex("\\s+"), " ");
+      while (!s.empty() && s.back() == ' ')
+        s.pop_back();
+      while (!s.empty() && s.front() == ' ')
+        s.erase(s.begin());
+      return s;
+    }
+
+    std::string trim(const std::string &s)
+    {
+      const auto b = s.find_first_not_of(" \t\r");
+      const auto e = s.find_last_not_of(" \t\r");
+      return b == std::string::npos ? "" : s.substr(b, e - b + 1);
+    }
+  } // namespace
+
+  ParameterFile::ParameterFile(dealii::ParameterHandler &prm)
+    : prm(prm)
+  {}
+
+  std::vector<std::string> ParameterFile::split_path(const std::string &path)
+  {
+    std::vector<std::string> parts;
+    std::string              item;
+    std::istringstream       is(path);
+    while (std::getline(is, item, '/'))
+      parts.push_back(trim(item));
+    return parts;
+  }
+
+  void ParameterFile::parse(const std::string &filename)
+  {
+    file = filename;
+    std::ifstream in(filename);
+    if (!in)
+      throw InputError(filename + ": cannot open the parameter file (missing or unreadable)");
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    text = buffer.str();
+
+    // Record the line of every "set" so later checks can point at it.
+    std::vector<std::string> sections;
+    std::istringstream       is(text);
+    std::string              line;
+    unsigned int             number = 0;
+    static const std::regex  sub_re("^\\s*subsection\\s+(.*?)\\s*$", std::regex::icase);
+    static const std::regex  end_re("^\\s*end\\s*$", std::regex::icase);
+    static const std::regex  set_re("^\\s*set\\s+(.*?)\\s*=.*$", std::regex::icase);
+    while (std::getline(is, line))
+      {
+        ++number;
+        const std::string code = line.substr(0, line.find('#'));
+        std::smatch       m;
+        if (std::regex_match(code, m, sub_re))
+          sections.push_back(trim(m[1]));
+        else if (std::regex_match(code, end_re) && !sections.empty())
+          sections.pop_back();
+        else if (std::regex_match(code, m, set_re))
+          {
+            std::string path;
+            for (const auto &s : sections)
+              path += s + "/";
+            lines[path + trim(m[1])] = number;
+          }
+      }
+
+    try
+      {
+        prm.parse_input(filename);
+      }
+    catch (const dealii::ParameterHandler::ExcInvalidEntryForPattern &e)
+      {
+        throw InputError(filename + ": " + describe(e));
+      }
+    catch (const dealii::ExceptionBase &e)
+      {
+        throw InputError(filename + ": " + describe(e));
+      }
+  }
+
+  void ParameterFile::set(const std::string &assignment)
+  {
+    const auto eq = assignment.find('=');
+    if (eq == std::string::npos)
+      throw InputError("--set '" + assignment + "': expected \"Subsection/Entry=value\"");
+    const std::string path  = trim(assignment.substr(0, eq));
+    const std::string value = trim(assignment.substr(eq + 1));
+    auto              parts = split_path(path);
+    const std::string entry = parts.back();
+    parts.pop_back();
+    unsigned int depth = 0;
+    try
+      {
+        for (const auto &s : parts)
+          {
+            if (!prm.subsection_path_exists({s}))
+              throw InputError("--set '" + assignment + "': there is no subsection '" + s +
+                               "' (see `tribo params`)");
+            prm.enter_subsection(s);
+            ++depth;
+          }
+        prm.get(entry); // throws if the entry is not declared
+        prm.set(entry, value);
+      }
+    catch (const dealii::ExceptionBase &e)
+      {
+        for (; depth > 0; --depth)
+          prm.leave_subsection();
+        throw InputError("--set '" + assignment + "': " + describe(e));
+      }
+    catch (...)
+      {
+        for (; depth > 0; --depth)
+          prm.leave_subsection();
+        throw;
+      }
+    for (; depth > 0; --depth)
+      prm.leave_subsection();
+    overridden[path] = true;
+  }
+
+  std::string ParameterFile::get(const std::string &path) const
+  {
+    auto              parts = split_path(path);
+    const std::string entry = parts.back();
+    parts.pop_back();
+    return prm.get(parts, entry);
+  }
+
+  double ParameterFile::get_double(const std::string &path) const
+  {
+    const std::string v = get(path);
+    try
+      {
+        std::size_t n = 0;
+        const double d = std::stod(v, &n);
+        if (trim(v.substr(n)).empty())
+          return d;
+      }
+    catch (const std::exception &)
+      {}
+    fail(path, "a number");
+  }
+
+  long ParameterFile::get_integer(const std::string &path) const
+  {
+    const std::string v = get(path);
+    try
+      {
+        std::size_t n = 0;
+        const long  i = std::stol(v, &n);
+        if (trim(v.substr(n)).empty())
+          return i;
+      }
+    catch (const std::exception &)
+      {}
+    fail(path, "an integer");
+  }
+
+  bool ParameterFile::get_bool(const std::string &path) const
+  {
+    const std::string v = get(path);
+    if (v == "true" || v == "yes")
+      return true;
+    if (v == "false" || v == "no")
+      return false;
+    fail(path, "true or false");
+  }
+
+  std::string ParameterFile::where(const std::string &path) const
+  {
+    if (overridden.count(path))
+      return "--set";
+    const auto it = lines.find(path);
+    if (it != lines.end())
+      return file + ":" + std::to_string(it->second);
+    return file + " (default)";
+  }
+
+  void ParameterFile::fail(const std::string &path, const std::string &expected) const
+  {
+    throw InputError(where(path) + ": entry '" + path + "' = '" + get(path) + "': expected " +
+                     expected);
+  }
+} // namespace tribo

@@ -1,0 +1,44 @@
+// results.h5 through deal.II's HDF5 wrappers (serial file access).
+#include "core/errors.h"
+#include "core/output.h"
+
+#include <deal.II/base/hdf5.h>
+
+#include <cstdio>
+
+namespace tribo
+{
+  void write_results_h5(const std::string &path, const TimeSeries &statistics,
+                        const std::map<std::string, std::string> &parameters,
+                        const std::map<std::string, double> &scalars)
+  {
+    const std::string tmp = path + ".tmp";
+    try
+      {
+        dealii::HDF5::File file(tmp, dealii::HDF5::File::FileAccessMode::create);
+        for (const auto &[name, value] : scalars)
+          file.set_attribute(name, value);
+
+        auto group = file.create_group("statistics");
+        for (const auto &name : statistics.columns())
+          {
+            const std::vector<double> values = statistics.column(name);
+            if (values.empty())
+              continue; // HDF5 datasets cannot be empty through this wrapper
+            group.write_dataset(name, values);
+          }
+        group.set_attribute("n_rows", static_cast<unsigned int>(statistics.rows().size()));
+
+        auto prm = file.create_group("parameters");
+        for (const auto &[name, value] : parameters)
+          prm.set_attribute(name, value);
+      }
+    catch (const std::exception &e)
+      {
+        std::remove(tmp.c_str());
+        throw RunError("cannot write " + path + ": " + e.what());
+      }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+      throw RunError("cannot rename " + tmp + " to " + path);
+  }
+} // namespace tribo

@@ -1,0 +1,123 @@
+#include "dem/contact.h"
+
+#include "core/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace tribo::dem
+{
+  std::vector<Contact> ContactDetector::detect(const ParticleSystem &system,
+                                               const std::vector<Vec2> &centres, double distance)
+  {
+    std::vector<Contact> contacts;
+    const std::size_t    n = centres.size();
+    if (n < 2)
+      return contacts;
+
+    // Cell size: the largest centre distance that can still be a contact.
+    const double reach = 2 * system.max_radius() + std::max(distance, 0.0);
+    double       xmin = centres[0].x(), xmax = xmin, ymin = centres[0].y(), ymax = ymin;
+    for (const auto &c : centres)
+      {
+        xmin = std::min(xmin, c.x());
+        xmax = std::max(xmax, c.x());
+        ymin = std::min(ymin, c.y());
+        ymax = std::max(ymax, c.y());
+      }
+    const bool periodic = system.period > 0;
+    if (periodic)
+      {
+        if (system.period < 2 * reach)
+          throw RunError("the period along x (" + std::to_string(system.period) +
+                         " m) is shorter than two contact reaches (" +
+                         std::to_string(2 * reach) + " m): enlarge the domain");
+        xmin = 0;
+        xmax = system.period;
+      }
+    const auto cells_along = [&](double length) {
+      return std::max<long>(1, std::min<long>(long(length / reach), 1L << 20));
+    };
+    const long   nx = cells_along(xmax - xmin), ny = cells_along(ymax - ymin);
+    const double wx = periodic ? system.period / nx : std::max(reach, (xmax - xmin) / nx);
+    const double wy = std::max(reach, (ymax - ymin) / ny);
+    const auto   cell_x = [&](double x) { return std::clamp<long>(long((x - xmin) / wx), 0, nx - 1); };
+    const auto   cell_y = [&](double y) { return std::clamp<long>(long((y - ymin) / wy), 0, ny - 1); };
+
+    // Counting sort of the discs by cell.
+    cell_start.assign(nx * ny + 1, 0);
+    cell_of.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      {
+        cell_of[i] = cell_y(centres[i].y()) * nx + cell_x(centres[i].x());
+        ++cell_start[cell_of[i] + 1];
+      }
+    for (long c = 0; c < nx * ny; ++c)
+      cell_start[c + 1] += cell_start[c];
+    cell_items.resize(n);
+    {
+      std::vector<unsigned int> fill(cell_start.begin(), cell_start.end() - 1);
+      for (std::size_t i = 0; i < n; ++i)
+        cell_items[fill[cell_of[i]]++] = i;
+    }
+
+    for (long cy = 0; cy < ny; ++cy)
+      for (long cx = 0; cx < nx; ++cx)
+        {
+          // The distinct neighbour cells (fewer than 9 when nx or ny < 3).
+          long neighbours[9];
+          int  n_neighbours = 0;
+          for (long dy = -1; dy <= 1; ++dy)
+            for (long dx = -1; dx <= 1; ++dx)
+              {
+                long x = cx + dx, y = cy + dy;
+                if (y < 0 || y >= ny)
+                  continue;
+                if (x < 0 || x >= nx)
+                  {
+                    if (!periodic)
+                      continue;
+                    x = (x + nx) % nx;
+                  }
+                const long c = y * nx + x;
+                if (std::find(neighbours, neighbours + n_neighbours, c) == neighbours + n_neighbours)
+                  neighbours[n_neighbours++] = c;
+              }
+          const long here = cy * nx + cx;
+          for (unsigned int a = cell_start[here]; a < cell_start[here + 1]; ++a)
+            {
+              const unsigned int i = cell_items[a];
+              for (int k = 0; k < n_neighbours; ++k)
+                for (unsigned int b = cell_start[neighbours[k]]; b < cell_start[neighbours[k] + 1]; ++b)
+                  {
+                    const unsigned int j = cell_items[b];
+                    if (j <= i || system.discs[i].body == system.discs[j].body)
+                      continue;
+                    Vec2 branch = centres[j] - centres[i];
+                    if (periodic)
+                      branch.x() -= system.period * std::round(branch.x() / system.period);
+                    const double ri = system.discs[i].radius, rj = system.discs[j].radius;
+                    const double reach_ij = ri + rj + distance;
+                    const double d2       = branch.squaredNorm();
+                    if (d2 > reach_ij * reach_ij)
+                      continue;
+                    const double dist = std::sqrt(d2);
+                    if (dist == 0)
+                      throw RunError("discs " + std::to_string(i) + " and " + std::to_string(j) +
+                                     " have the same centre: the contact normal is undefined");
+                    Contact c;
+                    c.disc[0] = i;
+                    c.disc[1] = j;
+                    c.body[0] = system.discs[i].body;
+                    c.body[1] = system.discs[j].body;
+                    c.branch  = branch;
+                    c.normal  = branch / dist;
+                    c.gap     = dist - ri - rj;
+                    contacts.push_back(c);
+                  }
+            }
+        }
+    return contacts;
+  }
+} // namespace tribo::dem

@@ -1,0 +1,53 @@
+#pragma once
+/// @file Contacts between discs of different bodies and their detection.
+
+#include "dem/particle_system.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace tribo::dem
+{
+  /// A contact (or near contact) between disc 0 and disc 1 of two bodies, in
+  /// the frame of contact_law.h: normal n from disc 0 to disc 1, t = (-n_y, n_x).
+  struct Contact
+  {
+    unsigned int disc[2] = {0, 0};
+    unsigned int body[2] = {0, 0};
+    Vec2   normal = Vec2::Zero(); ///< unit normal, disc 0 -> disc 1
+    Vec2   branch = Vec2::Zero(); ///< centre of disc 1 minus centre of disc 0 (periodic image), m
+    double gap    = 0;            ///< at the predicted configuration, m (negative: overlap)
+    /// Moment arms of the unit normal and tangent about each body centre,
+    /// (contact point - body centre) x n and x t, m. They make the rows of H:
+    /// u = H_1^T qdot_1 - H_0^T qdot_0 with H_b^T = [n^T, an_b; t^T, at_b].
+    double arm_n[2] = {0, 0}, arm_t[2] = {0, 0};
+    Eigen::Matrix2d W      = Eigen::Matrix2d::Zero(); ///< own Delassus block sum_b H_b^T M_b^-1 H_b, m/s per N s/m
+    Eigen::Vector2d r      = Eigen::Vector2d::Zero(); ///< impulse, N s/m
+    Eigen::Vector2d u      = Eigen::Vector2d::Zero(); ///< local velocity after its last local solve, m/s
+    Eigen::Vector2d u_free = Eigen::Vector2d::Zero(); ///< local velocity of the free motion (no impulses), m/s
+    double cohesion_impulse = 0, shift = 0, compliance = 0; ///< law terms (ContactLaw::Terms)
+
+    /// Key of the disc pair (smaller index first), for warm starts.
+    std::uint64_t key() const
+    {
+      return (std::uint64_t(disc[0]) << 32) | disc[1];
+    }
+  };
+
+  /// Cell-list detection of disc pairs closer than a detection distance,
+  /// linear in the number of discs, with minimum-image pairs across an
+  /// x-periodic boundary. Discs of the same body are never paired.
+  class ContactDetector
+  {
+  public:
+    /// Contacts (geometry only) for disc centres @p centres (already wrapped
+    /// into [0, period) if periodic) with gap <= @p distance.
+    std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &centres,
+                                double distance);
+
+  private:
+    std::vector<unsigned int> cell_start, cell_items, cell_of;
+  };
+} // namespace tribo::dem

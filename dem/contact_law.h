@@ -1,0 +1,108 @@
+#pragma once
+/// @file Contact laws of the NSCD engine and their closed-form local solves.
+///
+/// Sign conventions, for a contact between discs 0 and 1:
+/// - the normal n points from disc 0 to disc 1, the tangent is t = (-n_y, n_x);
+/// - the gap g = |x_1 - x_0| - R_0 - R_1 (m) is negative for an overlap;
+/// - the local velocity u = (u_n, u_t) is the velocity of disc 1 relative to
+///   disc 0 at the contact point, u_n > 0 when the discs separate;
+/// - the impulse r = (r_n, r_t) = h F (N s/m) acts on disc 1 and -r on disc 0;
+///   r_n > 0 pushes the discs apart (compression), r_n < 0 pulls (cohesion).
+///
+/// Both laws act on the gap at the end of the step predicted from the
+/// Moreau-Jean position update, g_end = g + theta h u_n, where g is the gap at
+/// the predicted configuration q + (1 - theta) h v_begin. Cohesion gamma (N/m)
+/// acts while g <= d_w: the laws are written on the shifted impulse
+/// r~_n = r_n + gamma h >= 0 (so r_n >= -gamma h, Cao et al. 2011 eq. 7).
+/// - IQS (inelastic quasi-shock): 0 <= r~_n  _|_  u_n + max(0, g)/(theta h) >= 0:
+///   a closing gap is closed exactly at the end of the step and an existing
+///   overlap is frozen (never pushed out). Cao et al. eq. (7).
+/// - ELAS (elastic): F~_n = max(0, -k g_end), i.e. r~_n = h k max(0, -(g + theta h u_n)),
+///   solved in closed form as a Signorini problem with the shift g/(theta h)
+///   and the augmented diagonal W_nn + 1/(theta k h^2). Cao et al. eq. (8)
+///   (written there with the opposite sign for gamma).
+/// - Optional Coulomb friction mu: |r_t| <= mu r~_n, acting on the shifted impulse.
+
+#include <Eigen/Core>
+
+#include <cmath>
+
+namespace tribo::dem
+{
+  /// The contact law shared by all contacts of a scene.
+  struct ContactLaw
+  {
+    enum class Type
+    {
+      iqs,
+      elas
+    };
+    Type   type            = Type::iqs;
+    double cohesion        = 0; ///< gamma, N/m (force per unit depth)
+    double cohesion_range  = 0; ///< d_w, m
+    double stiffness       = 0; ///< k, N/m^2 (force per unit depth per metre of overlap), ELAS only
+    double friction        = 0; ///< Coulomb coefficient mu, dimensionless
+
+    /// The terms of one contact's local problem that depend on its gap.
+    struct Terms
+    {
+      double cohesion_impulse; ///< gamma h if g <= d_w, else 0 (N s/m)
+      double shift;            ///< velocity shift b (m/s): max(0,g)/(theta h) (IQS), g/(theta h) (ELAS)
+      double compliance;       ///< added to W_nn: 0 (IQS), 1/(theta k h^2) (ELAS), s m/kg
+    };
+
+    /// Terms of a contact with gap @p g (m) for step @p h (s) and @p theta.
+    Terms terms(double g, double h, double theta) const
+    {
+      Terms t;
+      t.cohesion_impulse = (cohesion > 0 && g <= cohesion_range) ? cohesion * h : 0;
+      if (type == Type::iqs)
+        {
+          t.shift      = (g > 0 ? g : 0) / (theta * h);
+          t.compliance = 0;
+        }
+      else
+        {
+          t.shift      = g / (theta * h);
+          t.compliance = 1 / (theta * stiffness * h * h);
+        }
+      return t;
+    }
+
+    /// Closed-form local solve. @p W is the contact's own 2x2 Delassus block
+    /// (m/s per N s/m), @p u_other the local velocity produced by
+    /// the free motion and every other impulse (u = W r + u_other). Returns r.
+    Eigen::Vector2d solve(const Eigen::Matrix2d &W, const Eigen::Vector2d &u_other,
+                          const Terms &t) const
+    {
+      const double gh = t.cohesion_impulse;
+      // Shifted problem: u = W r~ + q, with q = u_other - W (gh, 0) + (b, 0).
+      const double qn  = u_other.x() - W(0, 0) * gh + t.shift;
+      const double qt  = u_other.y() - W(1, 0) * gh;
+      const double Wnn = W(0, 0) + t.compliance;
+      Eigen::Vector2d r(0, 0);
+      if (friction <= 0)
+        {
+          r.x() = qn < 0 ? -qn / Wnn : 0;
+        }
+      else if (qn < 0) // closing: stick if inside the cone, else slide
+        {
+          const double det = Wnn * W(1, 1) - W(0, 1) * W(1, 0);
+          const double rn  = (-qn * W(1, 1) + qt * W(0, 1)) / det;
+          const double rt  = (-qt * Wnn + qn * W(1, 0)) / det;
+          if (rn > 0 && std::abs(rt) <= friction * rn)
+            r = {rn, rt};
+          else
+            {
+              // Sliding: r_t = s mu r~_n, s the sign of the stick trial's r_t.
+              const double s     = (rt >= 0 ? 1.0 : -1.0);
+              const double denom = Wnn + s * friction * W(0, 1);
+              if (denom > 0)
+                r = {-qn / denom, -s * friction * qn / denom};
+            }
+        }
+      r.x() -= gh;
+      return r;
+    }
+  };
+} // namespace tribo::dem

@@ -1,0 +1,156 @@
+#include "dem/moreau_jean.h"
+
+#include "core/errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace tribo::dem
+{
+  MoreauJean::MoreauJean(double theta, const ContactLaw &law, const NlgsParameters &solver,
+                         double detection_distance)
+    : th(theta)
+    , contact_law(law)
+    , solver(solver)
+    // The detection distance always covers the cohesion range.
+    , distance(std::max(detection_distance, law.cohesion_range))
+  {}
+
+  StepReport MoreauJean::step(ParticleSystem &system, double h)
+  {
+    StepReport        report;
+    const std::size_t nb = system.bodies.size();
+
+    // Free velocities and the predicted configuration.
+    state.velocity.resize(nb);
+    state.inverse_mass.resize(nb);
+    std::vector<Eigen::Vector3d> v_begin(nb);
+    std::vector<Vec2>            x_pred(nb);
+    std::vector<double>          angle_pred(nb);
+    for (std::size_t b = 0; b < nb; ++b)
+      {
+        const RigidBody &body = system.bodies[b];
+        v_begin[b]            = {body.velocity.x(), body.velocity.y(), body.spin};
+        state.inverse_mass[b] = body.inverse_mass();
+        Eigen::Vector3d v     = v_begin[b];
+        for (int k = 0; k < 3; ++k)
+          if (body.drive[k] == Drive::force)
+            v[k] += h * state.inverse_mass[b][k] * body.load[k];
+        state.velocity[b] = v;
+        x_pred[b]         = body.position + (1 - th) * h * body.velocity;
+        angle_pred[b]     = body.angle + (1 - th) * h * body.spin;
+      }
+
+    // Detection at the predicted configuration.
+    centres.resize(system.discs.size());
+    for (std::size_t d = 0; d < system.discs.size(); ++d)
+      {
+        const Disc &disc = system.discs[d];
+        centres[d] = system.wrap(x_pred[disc.body] + rotate(disc.offset, angle_pred[disc.body]));
+      }
+    std::vector<Contact> found = detector.detect(system, centres, distance);
+
+    // Geometry of H, the own Delassus blocks, law terms, free velocities, warm start.
+    current.clear();
+    current.reserve(found.size());
+    for (Contact &c : found)
+      {
+        const Vec2 t(-c.normal.y(), c.normal.x());
+        // Contact point: middle of the gap (or overlap) on the line of centres;
+        // arms from each body centre = the disc's offset + the point from the disc centre.
+        const Vec2 point_from0 = (system.discs[c.disc[0]].radius + 0.5 * c.gap) * c.normal;
+        const Vec2 arm0 = rotate(system.discs[c.disc[0]].offset, angle_pred[c.body[0]]) + point_from0;
+        const Vec2 arm1 = rotate(system.discs[c.disc[1]].offset, angle_pred[c.body[1]]) +
+                               point_from0 - c.branch;
+        c.arm_n[0] = cross(arm0, c.normal);
+        c.arm_t[0] = cross(arm0, t);
+        c.arm_n[1] = cross(arm1, c.normal);
+        c.arm_t[1] = cross(arm1, t);
+        c.W        = state.delassus_block(c);
+        if (c.W(0, 0) <= 0)
+          continue; // both bodies have imposed velocities: nothing to solve
+        const auto terms   = contact_law.terms(c.gap, h, th);
+        c.cohesion_impulse = terms.cohesion_impulse;
+        c.shift            = terms.shift;
+        c.compliance       = terms.compliance;
+        c.u_free           = state.local_velocity(c);
+        const auto it      = previous_impulse.find(c.key());
+        c.r                = it != previous_impulse.end() ? it->second : Eigen::Vector2d::Zero();
+        current.push_back(c);
+      }
+    report.n_contacts = current.size();
+    for (const Contact &c : current)
+      if (c.r.x() != 0 || c.r.y() != 0)
+        state.apply_impulse(c, c.r);
+
+    report.solver = solver.solve(current, state, contact_law);
+
+    // Gap measures with the final velocities.
+    previous_impulse.clear();
+    double eps_sum = 0, min_gap_end = 0;
+    for (const Contact &c : current)
+      {
+        if (c.r.x() == 0 && c.r.y() == 0)
+          continue;
+        previous_impulse[c.key()] = c.r;
+        ++report.n_active;
+        const double un = state.local_velocity(c).x();
+        eps_sum += th * h * (un - c.u_free.x());
+        min_gap_end = std::min(min_gap_end, c.gap + th * h * un);
+      }
+    report.epsilon     = report.n_active ? eps_sum / report.n_active : 0;
+    report.max_overlap = std::max(0.0, -min_gap_end);
+
+    // Contact force on every body over the step.
+    body_force.assign(nb, Eigen::Vector3d::Zero());
+    for (const Contact &c : current)
+      {
+        const Vec2 t(-c.normal.y(), c.normal.x());
+        const Vec2 f = (c.r.x() * c.normal + c.r.y() * t) / h;
+        for (int s = 0; s < 2; ++s)
+          {
+            const double sign = s == 0 ? -1.0 : 1.0;
+            body_force[c.body[s]] +=
+              sign * Eigen::Vector3d(f.x(), f.y(), (c.arm_n[s] * c.r.x() + c.arm_t[s] * c.r.y()) / h);
+          }
+      }
+
+    // Update, powers and guards.
+    for (std::size_t b = 0; b < nb; ++b)
+      {
+        RigidBody             &body = system.bodies[b];
+        const Eigen::Vector3d &v    = state.velocity[b];
+        if (!v.allFinite())
+          {
+            std::ostringstream os;
+            os << "body " << b << " has a non-finite velocity (" << v.transpose()
+               << ") at position (" << body.position.transpose() << "): the solver diverged";
+            throw RunError(os.str());
+          }
+        const Eigen::Vector3d v_mid = 0.5 * (v_begin[b] + v);
+        for (int k = 0; k < 3; ++k)
+          {
+            if (body.drive[k] == Drive::velocity)
+              report.power_external -= body_force[b][k] * v_mid[k];
+            else if (body.drive[k] == Drive::force)
+              report.power_external += body.load[k] * v_mid[k];
+            report.power_contacts += body_force[b][k] * v_mid[k];
+            if (body.is_free())
+              report.power_free += (body_force[b][k] + (body.drive[k] == Drive::force ? body.load[k] : 0)) * v_mid[k];
+          }
+        body.velocity = v.head<2>();
+        body.spin     = v.z();
+        body.position = x_pred[b] + th * h * body.velocity;
+        body.angle    = angle_pred[b] + th * h * body.spin;
+        if (system.period > 0 && system.discs.size() > 0)
+          {
+            // Keep the body's reference point in [0, period); its discs follow.
+            const double shift = system.period * std::floor(body.position.x() / system.period);
+            body.position.x() -= shift;
+          }
+      }
+    report.kinetic_energy = system.kinetic_energy();
+    return report;
+  }
+} // namespace tribo::dem

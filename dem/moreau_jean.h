@@ -1,0 +1,74 @@
+#pragma once
+/// @file The Moreau-Jean theta scheme for rigid bodies with contact impulses
+/// (Cao et al. 2011, eqs. 4-5; Jean 1999). Over a step [t_i, t_i + h]:
+/// - free velocity: v_free = v_i + h M^-1 F_ext (constant imposed loads);
+/// - detection at the predicted configuration q_pred = q_i + (1 - theta) h v_i;
+/// - local problems u = W r + u_free with W = H^T M^-1 H, solved by NLGS;
+/// - velocity v_{i+1} = v_free + M^-1 H r, position q_{i+1} = q_pred + theta h v_{i+1}.
+/// Imposed-velocity dofs keep their velocity. Impulses are warm-started from
+/// the previous step's contact between the same two discs.
+
+#include "dem/contact.h"
+#include "dem/contact_law.h"
+#include "dem/nlgs.h"
+#include "dem/particle_system.h"
+
+#include <Eigen/Core>
+
+#include <unordered_map>
+#include <vector>
+
+namespace tribo::dem
+{
+  /// Measurements of one step.
+  struct StepReport
+  {
+    unsigned int n_contacts = 0; ///< detected pairs within the detection distance
+    unsigned int n_active   = 0; ///< contacts with a non-zero impulse
+    NlgsReport   solver;
+    /// Cao et al. eq. (13): mean over active contacts of g_c - g_p, the end-of-step
+    /// gap with contact impulses minus the one without, theta h (u_n - u_free,n), m.
+    double epsilon = 0;
+    /// Largest overlap at the end of the step, max(0, -min g_end), m.
+    double max_overlap = 0;
+    double kinetic_energy = 0; ///< after the step, J/m
+    /// Power of the drivers: reactions of imposed-velocity dofs (minus the contact
+    /// force on them) and imposed loads, times the mean velocity over the step, W/m.
+    double power_external = 0;
+    /// Power of all forces (contact and imposed) on the free bodies, W/m (Cao eq. 10).
+    double power_free = 0;
+    /// Power of the contact forces on all bodies, W/m (<= 0: dissipation).
+    double power_contacts = 0;
+  };
+
+  /// The integrator; it owns the contacts of the current step.
+  class MoreauJean
+  {
+  public:
+    MoreauJean(double theta, const ContactLaw &law, const NlgsParameters &solver,
+               double detection_distance);
+
+    /// Advance @p system by one step @p h (s).
+    StepReport step(ParticleSystem &system, double h);
+
+    /// Contacts of the last step with their impulses (N s/m).
+    const std::vector<Contact> &contacts() const { return current; }
+    /// Contact force (Fx, Fy in N/m, torque in N) on each body over the last step.
+    const std::vector<Eigen::Vector3d> &contact_force() const { return body_force; }
+    const ContactLaw &law() const { return contact_law; }
+    double theta() const { return th; }
+    double detection_distance() const { return distance; }
+
+  private:
+    double                   th;
+    ContactLaw               contact_law;
+    NlgsSolver               solver;
+    double                   distance;
+    ContactDetector          detector;
+    std::vector<Contact>     current;
+    std::unordered_map<std::uint64_t, Eigen::Vector2d> previous_impulse;
+    BodyState                state;
+    std::vector<Eigen::Vector3d> body_force;
+    std::vector<Vec2>        centres;
+  };
+} // namespace tribo::dem

@@ -1,0 +1,123 @@
+#include "dem/nlgs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace tribo::dem
+{
+  Eigen::Matrix2d BodyState::delassus_block(const Contact &c) const
+  {
+    const Vec2      t(-c.normal.y(), c.normal.x());
+    Eigen::Matrix2d W = Eigen::Matrix2d::Zero();
+    for (int s = 0; s < 2; ++s)
+      {
+        const auto &im = inverse_mass[c.body[s]];
+        // Columns of H_b: generalized impulse (Fx, Fy, torque) of a unit r_n and r_t.
+        const Eigen::Vector3d hn(c.normal.x(), c.normal.y(), c.arm_n[s]);
+        const Eigen::Vector3d ht(t.x(), t.y(), c.arm_t[s]);
+        const Eigen::Vector3d m(im[0], im[1], im[2]);
+        W(0, 0) += hn.cwiseProduct(m).dot(hn);
+        W(0, 1) += hn.cwiseProduct(m).dot(ht);
+        W(1, 1) += ht.cwiseProduct(m).dot(ht);
+      }
+    W(1, 0) = W(0, 1);
+    return W;
+  }
+
+  NlgsSolver::NlgsSolver(const NlgsParameters &p)
+    : prm(p)
+    , rng(p.seed)
+  {}
+
+  NlgsReport NlgsSolver::solve(std::vector<Contact> &contacts, BodyState &state,
+                               const ContactLaw &law)
+  {
+    NlgsReport report;
+    const std::size_t n = contacts.size();
+    if (n == 0)
+      return report;
+    order.resize(n);
+    std::iota(order.begin(), order.end(), 0u);
+    for (auto &c : contacts)
+      c.u = state.local_velocity(c);
+
+    const double tol   = prm.tolerance;
+    const double omega = prm.relaxation;
+    report.converged   = false;
+    for (unsigned int sweep = 1; sweep <= prm.max_iterations; ++sweep)
+      {
+        if (prm.random_order)
+          std::shuffle(order.begin(), order.end(), rng);
+        const bool check = (sweep % prm.check_interval == 0) || sweep == prm.max_iterations;
+        double     sum_wrwr = 0, sum_wrr = 0, sum_dvdv = 0, sum_dvdvrr = 0, sum_dvor = 0;
+        double     max_dvdv = 0, max_dvdvrr = 0;
+        unsigned int active = 0;
+        for (const unsigned int a : order)
+          {
+            Contact              &c       = contacts[a];
+            const Eigen::Vector2d u_now   = state.local_velocity(c);
+            const Eigen::Vector2d r_old   = c.r;
+            const Eigen::Vector2d u_other = u_now - c.W * r_old;
+            const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
+            Eigen::Vector2d       r_new   = law.solve(c.W, u_other, terms);
+            if (omega != 1.0)
+              r_new = omega * r_new + (1 - omega) * r_old;
+            const Eigen::Vector2d dr = r_new - r_old;
+            if (dr.x() != 0 || dr.y() != 0)
+              state.apply_impulse(c, dr);
+            const Eigen::Vector2d u_after = u_now + c.W * dr;
+            if (check && (r_new.x() != 0 || r_new.y() != 0))
+              {
+                ++active;
+                const Eigen::Vector2d dv    = u_after - c.u;
+                const Eigen::Vector2d r_bar = 0.5 * (r_old + r_new);
+                const Eigen::Vector2d wr    = c.W * r_new;
+                const double wrr  = 0.5 * ((c.W * r_old).dot(r_old) + wr.dot(r_new));
+                const double dvdv = dv.squaredNorm();
+                sum_wrwr += wr.squaredNorm();
+                sum_wrr += wrr;
+                sum_dvdv += dvdv;
+                sum_dvdvrr += dvdv * r_bar.squaredNorm();
+                sum_dvor += r_bar.dot(dv);
+                max_dvdv   = std::max(max_dvdv, dvdv);
+                max_dvdvrr = std::max(max_dvdvrr, dvdv * r_bar.squaredNorm());
+              }
+            c.r = r_new;
+            c.u = u_after;
+          }
+        report.iterations = sweep;
+        if (!check)
+          continue;
+        if (active == 0)
+          {
+            report.converged = true;
+            report.residual  = 0;
+            break;
+          }
+        const double N         = active;
+        const double quad_wr   = std::sqrt(sum_wrwr / N);
+        const double mean_wrr  = sum_wrr / N;
+        const double mean_dvor = sum_wrr > 0 ? sum_dvor / (sum_wrr * tol) : 0;
+        double dv_norm, dvr_norm;
+        if (prm.norm == NlgsParameters::Norm::quad)
+          {
+            dv_norm  = quad_wr > 0 ? std::sqrt(sum_dvdv / N) / (quad_wr * tol) : 0;
+            dvr_norm = mean_wrr > 0 ? std::sqrt(sum_dvdvrr / N) / (mean_wrr * tol) : 0;
+          }
+        else
+          {
+            dv_norm  = quad_wr > 0 ? std::sqrt(max_dvdv) / (quad_wr * tol) : 0;
+            dvr_norm = mean_wrr > 0 ? std::sqrt(max_dvdvrr) / (mean_wrr * tol) : 0;
+          }
+        const double criterion = std::max({std::abs(mean_dvor), dv_norm, dvr_norm});
+        report.residual        = criterion * tol;
+        if (criterion < 1)
+          {
+            report.converged = true;
+            break;
+          }
+      }
+    return report;
+  }
+} // namespace tribo::dem

@@ -1,0 +1,108 @@
+#pragma once
+/// @file Nonlinear Gauss-Seidel on the Delassus operator, in the
+/// "exchange local/global" form: body velocities are kept up to date and each
+/// local solve reads its contact's velocity from them (no off-diagonal W stored).
+///
+/// Convergence is checked every `check_interval` sweeps with the norms of the
+/// established NSCD code (LMGC90, see ../shared/notes/nscd-reference.md), over the
+/// N contacts with r != 0, comparing each contact's state across one sweep:
+/// dV = u after this sweep's local solve - u after the previous one (m/s),
+/// r_bar = (r_before + r_after)/2, WR = W r (m/s), WRR = (W r.r before + after)/2.
+/// - QuadWR = sqrt(sum |WR|^2 / N), MeanWRR = sum WRR / N;
+/// - QuadDV = sqrt(sum |dV|^2 / N) / (QuadWR tol), MaxmDV with max |dV|^2;
+/// - QuadDVR = sqrt(sum |dV|^2 |r_bar|^2 / N) / (MeanWRR tol), MaxmDVR with the max;
+/// - MeanDVoR = sum r_bar.dV / (sum WRR tol).
+/// "Quad" has converged when |MeanDVoR|, QuadDV and QuadDVR are all below 1,
+/// "Maxm" when |MeanDVoR|, MaxmDV and MaxmDVR are.
+
+#include "dem/contact.h"
+#include "dem/contact_law.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <random>
+#include <vector>
+
+namespace tribo::dem
+{
+  /// Controls of the NLGS solver.
+  struct NlgsParameters
+  {
+    enum class Norm
+    {
+      quad,
+      maxm
+    };
+    double       tolerance      = 1e-4;
+    Norm         norm           = Norm::quad;
+    double       relaxation     = 1.0; ///< omega: r <- omega r_law + (1 - omega) r_old
+    unsigned int check_interval = 10;  ///< sweeps between convergence checks
+    unsigned int max_iterations = 10000; ///< sweeps
+    bool         random_order   = false; ///< shuffle the contact order every sweep
+    unsigned int seed           = 1;
+  };
+
+  /// What one solve achieved.
+  struct NlgsReport
+  {
+    unsigned int iterations = 0;    ///< sweeps done
+    bool         converged  = true;
+    /// The achieved criterion: max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm
+    /// ones) times tol, i.e. the relative quantity that is compared with tol.
+    double residual = 0;
+  };
+
+  /// Velocities and inverse masses of the bodies as the solver sees them:
+  /// (v_x, v_y, spin) and (1/m, 1/m, 1/I), with 0 for imposed-velocity dofs.
+  struct BodyState
+  {
+    std::vector<Eigen::Vector3d>       velocity;
+    std::vector<std::array<double, 3>> inverse_mass;
+
+    /// Local velocity of contact @p c from the current body velocities.
+    Eigen::Vector2d local_velocity(const Contact &c) const
+    {
+      const Eigen::Vector3d &v0 = velocity[c.body[0]], &v1 = velocity[c.body[1]];
+      const Vec2             t(-c.normal.y(), c.normal.x());
+      return {c.normal.dot(v1.head<2>() - v0.head<2>()) + c.arm_n[1] * v1.z() - c.arm_n[0] * v0.z(),
+              t.dot(v1.head<2>() - v0.head<2>()) + c.arm_t[1] * v1.z() - c.arm_t[0] * v0.z()};
+    }
+
+    /// Apply impulse @p dr of contact @p c: v_1 += M_1^-1 H_1 dr, v_0 -= M_0^-1 H_0 dr.
+    void apply_impulse(const Contact &c, const Eigen::Vector2d &dr)
+    {
+      const Vec2 t(-c.normal.y(), c.normal.x());
+      const Vec2 f = dr.x() * c.normal + dr.y() * t;
+      for (int s = 0; s < 2; ++s)
+        {
+          const double           sign = s == 0 ? -1.0 : 1.0;
+          const auto            &im   = inverse_mass[c.body[s]];
+          Eigen::Vector3d       &v    = velocity[c.body[s]];
+          v.x() += sign * im[0] * f.x();
+          v.y() += sign * im[1] * f.y();
+          v.z() += sign * im[2] * (c.arm_n[s] * dr.x() + c.arm_t[s] * dr.y());
+        }
+    }
+
+    /// The own Delassus block of @p c, sum over its two bodies of H^T M^-1 H.
+    Eigen::Matrix2d delassus_block(const Contact &c) const;
+  };
+
+  /// The solver; it keeps its random generator across steps (reproducible from the seed).
+  class NlgsSolver
+  {
+  public:
+    explicit NlgsSolver(const NlgsParameters &p = {});
+    /// Solve for the impulses of @p contacts (warm-started from their r, whose
+    /// effect must already be in @p state), updating @p state.
+    NlgsReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law);
+
+    const NlgsParameters &parameters() const { return prm; }
+
+  private:
+    NlgsParameters            prm;
+    std::mt19937              rng;
+    std::vector<unsigned int> order;
+  };
+} // namespace tribo::dem
