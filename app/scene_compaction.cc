@@ -58,7 +58,7 @@ namespace tribo::app
       std::vector<std::string> columns() const override
       {
         return {"upper_wall_y", "upper_wall_vy", "lower_wall_normal_force", "applied_force",
-                "solid_fraction"};
+                "solid_fraction", "power_lower_wall", "power_upper_wall"};
       }
 
       std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
@@ -69,7 +69,9 @@ namespace tribo::app
         const double height = s.bodies[upper].position.y() - s.bodies[lower].position.y();
         return {s.bodies[upper].position.y(), s.bodies[upper].velocity.y(),
                 f.empty() ? 0.0 : -f[lower].y(), -s.bodies[upper].load[1],
-                grain_area(s) / (height * prm.compaction.length)};
+                grain_area(s) / (height * prm.compaction.length),
+                mj.external_power().empty() ? 0.0 : mj.external_power()[lower],
+                mj.external_power().empty() ? 0.0 : mj.external_power()[upper]};
       }
 
       void summarize(const dem::ParticleSystem &s, const TimeSeries &stats, JsonObject &j) const override

@@ -117,6 +117,7 @@ namespace tribo::dem
       }
 
     // Update, powers and guards.
+    body_power.assign(nb, 0.0);
     for (std::size_t b = 0; b < nb; ++b)
       {
         RigidBody             &body = system.bodies[b];
@@ -132,13 +133,14 @@ namespace tribo::dem
         for (int k = 0; k < 3; ++k)
           {
             if (body.drive[k] == Drive::velocity)
-              report.power_external -= body_force[b][k] * v_mid[k];
+              body_power[b] -= body_force[b][k] * v_mid[k];
             else if (body.drive[k] == Drive::force)
-              report.power_external += body.load[k] * v_mid[k];
+              body_power[b] += body.load[k] * v_mid[k];
             report.power_contacts += body_force[b][k] * v_mid[k];
             if (body.is_free())
               report.power_free += (body_force[b][k] + (body.drive[k] == Drive::force ? body.load[k] : 0)) * v_mid[k];
           }
+        report.power_external += body_power[b];
         body.velocity = v.head<2>();
         body.spin     = v.z();
         body.position = x_pred[b] + th * h * body.velocity;

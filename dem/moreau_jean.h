@@ -55,6 +55,9 @@ namespace tribo::dem
     const std::vector<Contact> &contacts() const { return current; }
     /// Contact force (Fx, Fy in N/m, torque in N) on each body over the last step.
     const std::vector<Eigen::Vector3d> &contact_force() const { return body_force; }
+    /// External power on each body over the last step (drivers' reactions and
+    /// imposed loads times the mean velocity), W/m; sums to StepReport::power_external.
+    const std::vector<double> &external_power() const { return body_power; }
     const ContactLaw &law() const { return contact_law; }
     double theta() const { return th; }
     double detection_distance() const { return distance; }
@@ -69,6 +72,7 @@ namespace tribo::dem
     std::unordered_map<std::uint64_t, Eigen::Vector2d> previous_impulse;
     BodyState                state;
     std::vector<Eigen::Vector3d> body_force;
+    std::vector<double>          body_power;
     std::vector<Vec2>        centres;
   };
 } // namespace tribo::dem

@@ -127,30 +127,39 @@ TEST(Dynamics, CohesivePairEscapesOnlyAboveTheEscapeVelocity)
     }
 }
 
+namespace
+{
+  /// 16 discs between a sliding fixed-height wall (1 m/s) and a wall pushed down by 800 N/m.
+  ParticleSystem squeezed_layer()
+  {
+    ParticleSystem s;
+    s.period = 8e-6;
+    std::vector<Vec2>   c;
+    std::vector<double> rad;
+    for (int i = 0; i < 8; ++i)
+      {
+        c.push_back({(i + 0.5) * 1e-6, 0});
+        rad.push_back(0.5e-6);
+      }
+    const unsigned lower = s.add_clump(c, rad, rho);
+    for (auto &d : s.bodies[lower].drive)
+      d = Drive::velocity;
+    s.bodies[lower].velocity = {1.0, 0}; // sliding
+    for (int i = 0; i < 16; ++i)
+      s.add_disc({(i % 8 + 0.5 + 0.3 * (i / 8)) * 1e-6, (1.05 + 1.1 * (i / 8)) * 1e-6}, 0.5e-6, rho);
+    for (auto &p : c)
+      p.y() = 3.4e-6;
+    const unsigned upper = s.add_clump(c, rad, rho);
+    s.bodies[upper].drive = {{Drive::velocity, Drive::force, Drive::velocity}};
+    s.bodies[upper].load[1] = -800.0;
+    return s;
+  }
+} // namespace
+
 TEST(Dynamics, KineticEnergyChangeEqualsThePowerOfDriversAndContacts)
 {
-  // Discs squeezed between a fixed wall and a force-driven wall: every step,
-  // KE_after - KE_before = h (P_external + P_contacts) (midpoint velocities).
-  ParticleSystem s;
-  s.period = 8e-6;
-  std::vector<Vec2>   c;
-  std::vector<double> rad;
-  for (int i = 0; i < 8; ++i)
-    {
-      c.push_back({(i + 0.5) * 1e-6, 0});
-      rad.push_back(0.5e-6);
-    }
-  const unsigned lower = s.add_clump(c, rad, rho);
-  for (auto &d : s.bodies[lower].drive)
-    d = Drive::velocity;
-  s.bodies[lower].velocity = {1.0, 0}; // sliding
-  for (int i = 0; i < 16; ++i)
-    s.add_disc({(i % 8 + 0.5 + 0.3 * (i / 8)) * 1e-6, (1.05 + 1.1 * (i / 8)) * 1e-6}, 0.5e-6, rho);
-  for (auto &p : c)
-    p.y() = 3.4e-6;
-  const unsigned upper = s.add_clump(c, rad, rho);
-  s.bodies[upper].drive = {{Drive::velocity, Drive::force, Drive::velocity}};
-  s.bodies[upper].load[1] = -800.0;
+  // Every step, KE_after - KE_before = h (P_external + P_contacts) (midpoint velocities).
+  ParticleSystem s = squeezed_layer();
   MoreauJean mj(0.5, ContactLaw{}, tight(), 5e-8);
   double dissipated = 0;
   for (int i = 0; i < 300; ++i)
@@ -165,4 +174,35 @@ TEST(Dynamics, KineticEnergyChangeEqualsThePowerOfDriversAndContacts)
   // Frictionless IQS contacts dissipate over the run (a single step may not:
   // with midpoint velocities, a contact whose normal turned can give back a little).
   EXPECT_GT(dissipated, 0.0);
+}
+
+TEST(Dynamics, NlgsSolutionSatisfiesSignoriniAtConvergence)
+{
+  ParticleSystem s = squeezed_layer();
+  MoreauJean     mj(0.5, ContactLaw{}, tight(), 5e-8);
+  const double   h = 1e-9;
+  for (int i = 0; i < 200; ++i)
+    ASSERT_TRUE(mj.step(s, h).solver.converged);
+  // Recompute every contact's final local velocity from the bodies: with r_n > 0
+  // the end-of-step gap is closed (u_n = -shift), with r_n = 0 it stays open.
+  BodyState state;
+  for (const auto &b : s.bodies)
+    {
+      state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
+      state.inverse_mass.push_back(b.inverse_mass());
+    }
+  unsigned loaded = 0;
+  for (const auto &c : mj.contacts())
+    {
+      const double un    = state.local_velocity(c).x();
+      const double scale = 1.0; // m/s: the wall speed
+      EXPECT_GE(c.r.x(), 0.0);
+      EXPECT_GE(un + c.shift, -1e-6 * scale);
+      if (c.r.x() > 0)
+        {
+          ++loaded;
+          EXPECT_NEAR(un + c.shift, 0.0, 1e-6 * scale);
+        }
+    }
+  EXPECT_GT(loaded, 10u);
 }
