@@ -1,0 +1,92 @@
+// NLGS throughput on a dense packing: compacts a case (default
+// cases/compaction/bench.prm, ~3000 discs at 100 MPa), then times
+//  (1) fixed sweeps over the frozen contact set: contact updates per second;
+//  (2) full steps at the case's tolerance: sweeps, contacts and wall time per step.
+// Usage: bench_nlgs [CASE.prm] [compaction steps] [timed steps]
+#include "app/case_parameters.h"
+#include "app/scene.h"
+#include "core/parameter_file.h"
+#include "dem/moreau_jean.h"
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+using namespace tribo;
+using Clock = std::chrono::steady_clock;
+
+namespace
+{
+  double seconds_since(Clock::time_point t0)
+  {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+} // namespace
+
+int main(int argc, char **argv)
+{
+  const std::string case_file     = argc > 1 ? argv[1] : "cases/compaction/bench.prm";
+  const unsigned    compact_steps = argc > 2 ? std::stoul(argv[2]) : 3000;
+  const unsigned    timed_steps   = argc > 3 ? std::stoul(argv[3]) : 100;
+
+  dealii::ParameterHandler prm;
+  app::declare_case_parameters(prm);
+  ParameterFile file(prm);
+  file.parse(case_file);
+  const app::CaseParameters p = app::read_case_parameters(file);
+
+  auto                scene = app::make_scene(p);
+  dem::ParticleSystem system;
+  scene->build(system);
+  const double    h = scene->time_step(system);
+  dem::MoreauJean mj(p.theta, p.law, p.solver, p.detection_distance > 0 ? p.detection_distance : 0.1 * system.min_radius());
+
+  std::printf("case %s: %zu discs, h = %g s\n", case_file.c_str(), system.discs.size(), h);
+  auto t0 = Clock::now();
+  for (unsigned s = 0; s < compact_steps; ++s)
+    {
+      scene->before_step(system, s);
+      mj.step(system, h);
+    }
+  std::printf("compaction: %u steps in %.2f s\n", compact_steps, seconds_since(t0));
+
+  // (2) steps at the case's tolerance (warm-started, as in a run).
+  unsigned long sweeps = 0, contacts = 0, active = 0;
+  t0 = Clock::now();
+  for (unsigned s = 0; s < timed_steps; ++s)
+    {
+      scene->before_step(system, compact_steps + s);
+      const auto r = mj.step(system, h);
+      sweeps += r.solver.iterations;
+      contacts += r.n_contacts;
+      active += r.n_active;
+    }
+  const double step_time = seconds_since(t0) / timed_steps;
+  std::printf("steps at tol %g (%s, check every %u): %.4f s per step, %.1f sweeps, %.0f contacts "
+              "(%.0f active) per step\n",
+              p.solver.tolerance, p.solver.norm == dem::NlgsParameters::Norm::quad ? "Quad" : "Maxm",
+              p.solver.check_interval, step_time, double(sweeps) / timed_steps,
+              double(contacts) / timed_steps, double(active) / timed_steps);
+
+  // (1) fixed sweeps on the last step's contacts, from their converged impulses.
+  std::vector<dem::Contact> frozen = mj.contacts();
+  dem::BodyState            state;
+  for (const auto &b : system.bodies)
+    {
+      state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
+      state.inverse_mass.push_back(b.inverse_mass());
+    }
+  dem::NlgsParameters fixed = p.solver;
+  fixed.tolerance           = 1e-300; // never converges: exactly max_iterations sweeps
+  fixed.max_iterations      = 200;
+  fixed.check_interval      = 1000000;
+  dem::NlgsSolver solver(fixed);
+  t0 = Clock::now();
+  const auto   rep     = solver.solve(frozen, state, mj.law());
+  const double elapsed = seconds_since(t0);
+  const double updates = double(rep.iterations) * frozen.size();
+  std::printf("NLGS: %u sweeps over %zu contacts in %.3f s: %.3g contact updates per second "
+              "(%.1f ns per update)\n",
+              rep.iterations, frozen.size(), elapsed, updates / elapsed, 1e9 * elapsed / updates);
+  return 0;
+}
