@@ -27,20 +27,24 @@ namespace tribo::app
         for (auto &d : s.bodies[lower].drive)
           d = dem::Drive::velocity;
 
-        // Grains on a loose square grid above it, sizes drawn at random.
-        const double       pitch   = 1.05 * d_max;
+        // Grains on a loose triangular lattice above it (neighbours 1.02 d_max
+        // apart, so no initial overlap), sizes drawn at random.
+        const double       pitch   = 1.02 * d_max;
         const unsigned int columns = std::max(1u, unsigned(k.length / pitch));
+        const double       dx      = k.length / columns;
+        const double       dy      = std::sqrt(std::max(pitch * pitch - 0.25 * dx * dx, 0.0));
         const unsigned int rows    = (k.n_discs + columns - 1) / columns;
         for (unsigned int i = 0; i < k.n_discs; ++i)
           {
-            const double x = (i % columns + 0.5) * k.length / columns;
-            const double y = d_max + (i / columns + 0.5) * pitch;
+            const unsigned int row = i / columns;
+            const double       x   = (i % columns + 0.5 + 0.5 * (row % 2)) * dx;
+            const double       y   = d_max + 0.5 * pitch + row * dy;
             s.add_disc({x, y}, 0.5 * draw_diameter(), k.density);
           }
 
         // Upper wall above the grains: free in y under -P L, fixed in x and rotation,
         // with the mass of the first body it stands for.
-        upper = add_wall(s, d_max + rows * pitch + d_max / 2);
+        upper = add_wall(s, d_max + 0.5 * pitch + (rows - 1) * dy + pitch);
         auto &u   = s.bodies[upper];
         u.drive   = {{dem::Drive::velocity, dem::Drive::force, dem::Drive::velocity}};
         const double wall_mass = u.mass;
