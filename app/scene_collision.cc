@@ -1,6 +1,7 @@
 // Two discs in a head-on collision along x (Cao et al. 2011, Fig. 8).
 #include "app/scene.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace tribo::app
@@ -47,19 +48,23 @@ namespace tribo::app
         double       fn   = 0;
         if (!mj.contacts().empty())
           fn = mj.contact_force()[1].x();
-        if (fn != 0)
-          touched = true;
-        if (touched && fn == 0 && gap > mj.detection_distance())
+        // Round-off forces (a cohesive pair at rest) count as no force.
+        peak_force        = std::max(peak_force, std::abs(fn));
+        const bool loaded = std::abs(fn) > 1e-9 * std::max(prm.law.cohesion, peak_force);
+        if (loaded)
+          {
+            touched = true;
+            ++contact_steps;
+          }
+        if (touched && !loaded && gap > mj.detection_distance())
           separated = true;
-        if (fn != 0)
-          ++contact_steps;
         last_gap = gap;
         return {gap, vrel, fn, s.kinetic_energy() / energy_start - 1};
       }
 
       bool finished() const override { return prm.collision.stop_when_separated && separated; }
 
-      void summarize(const dem::ParticleSystem &s, const TimeSeries &, JsonObject &j) const override
+      void summarize(const dem::ParticleSystem &s, const TimeSeries &, JsonObject &j) override
       {
         const double dt_star = std::sqrt(m_eff / prm.law.stiffness);
         const double v_in    = prm.collision.impact_velocity;
@@ -71,15 +76,17 @@ namespace tribo::app
         j.set("separated", separated);
         j.set("kinetic_energy_initial", energy_start);
         j.set("kinetic_energy_final", s.kinetic_energy());
-        j.set("energy_loss", 1 - s.kinetic_energy() / energy_start);
-        j.set("restitution_coefficient", v_in > 0 ? v_out / v_in : -v_out / v_in);
+        // Only a pair that has separated has a final kinetic energy to compare:
+        // a bound pair still exchanges energy with the contact (null in JSON).
+        j.set("energy_loss", separated ? 1 - s.kinetic_energy() / energy_start : NAN);
+        j.set("restitution_coefficient", !separated ? NAN : v_in > 0 ? v_out / v_in : -v_out / v_in);
         j.set("final_gap", last_gap);
         j.set("contact_duration", contact_steps * time_step(s));
         j.set("elastic_contact_duration", M_PI * dt_star);
       }
 
     private:
-      double        m_eff = 0, energy_start = 0, last_gap = 0;
+      double        m_eff = 0, energy_start = 0, last_gap = 0, peak_force = 0;
       unsigned long contact_steps = 0;
       bool   touched = false, separated = false;
     };
