@@ -14,9 +14,10 @@ namespace tribo::app
   void declare_case_parameters(dealii::ParameterHandler &prm)
   {
     prm.enter_subsection("Simulation");
-    prm.declare_entry("Scene", "compaction", Selection("collision|compaction"),
+    prm.declare_entry("Scene", "compaction", Selection("collision|compaction|shear"),
                       "What to simulate: 'collision' (two discs, Cao et al. 2011 Fig. 8) or "
-                      "'compaction' (a periodic layer of discs pressed between two rough walls).");
+                      "'compaction' (a periodic layer of discs pressed between two rough walls) or "
+                      "'shear' (the third-body shear cell of Cao et al. 2011).");
     prm.declare_entry("Time step", "1e-9", Double(), "Time step h, s (> 0).");
     prm.declare_entry("End time", "1e-6", Double(), "Simulated time, s (> 0).");
     prm.declare_entry("Theta", "0.5", Double(0.5, 1.0),
@@ -87,6 +88,30 @@ namespace tribo::app
                       "density * thickness * L.");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
     prm.leave_subsection();
+
+    prm.enter_subsection("Shear cell");
+    prm.declare_entry("Number of discs", "3820", Integer(1), "Third-body discs, >= 1 (paper: 3820).");
+    prm.declare_entry("Mean diameter", "1.2e-6", Double(), "Mean disc diameter d, m (> 0; paper: 1.2e-6).");
+    prm.declare_entry("Diameter spread", "0.2", Double(0, 0.99),
+                      "Relative half-width s of the uniform diameter distribution [d(1-s), d(1+s)] (paper: 0.2).");
+    prm.declare_entry("Density", "7800", Double(), "Density of discs, walls and first bodies, kg/m^3 (> 0).");
+    prm.declare_entry("Length", "1e-4", Double(), "Period L along x, m (> 0; paper: 1e-4).");
+    prm.declare_entry("Wall discs", "72", Integer(0),
+                      "Discs in each rough wall, spread evenly along L (paper: 72); 0 gives L/d.");
+    prm.declare_entry("Pressure", "1e8", Double(), "Pressure P on the upper wall, Pa (> 0); force P L per unit depth.");
+    prm.declare_entry("Pressure ramp time", "2e-6", Double(), "Time over which P rises linearly from 0, s (>= 0).");
+    prm.declare_entry("Sliding velocity", "5", Double(), "Velocity V of the lower wall along x once shearing starts, m/s.");
+    prm.declare_entry("Shear start", "1e-5", Double(),
+                      "Time at which the lower wall starts sliding, s (>= 0): compaction before.");
+    prm.declare_entry("Upper body thickness", "1.5e-4", Double(),
+                      "Thickness of the first body the upper wall stands for, m (> 0; paper: 1.5e-4): "
+                      "its mass is density * thickness * L.");
+    prm.declare_entry("Profile samples", "500", Integer(1),
+                      "Profile samples, evenly spread over the shearing phase (paper: 500 in steady state).");
+    prm.declare_entry("Layer thickness", "0", Double(),
+                      "Thickness of the profile layers, m (>= 0); 0: one mean diameter.");
+    prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
+    prm.leave_subsection();
   }
 
   CaseParameters read_case_parameters(const ParameterFile &f)
@@ -149,12 +174,39 @@ namespace tribo::app
         const double d_max = k.mean_diameter * (1 + k.diameter_spread);
         if (k.length < 4 * d_max)
           f.fail("Compaction/Length", "a length of at least 4 largest diameters (" +
-                                        std::to_string(4 * d_max) + " m)");
+                                        to_text(4 * d_max) + " m)");
         k.pressure = f.get_checked("Compaction/Pressure", positive, "a positive pressure in Pa");
         k.ramp_steps = f.get_integer("Compaction/Pressure ramp steps");
         k.upper_body_thickness =
           f.get_checked("Compaction/Upper body thickness", positive, "a positive thickness in m");
         k.seed = f.get_integer("Compaction/Seed");
+      }
+    auto &sc = p.shear;
+    if (p.scene == "shear")
+      {
+        const std::string S = "Shear cell/";
+        sc.n_discs         = f.get_integer(S + "Number of discs");
+        sc.mean_diameter   = f.get_checked(S + "Mean diameter", positive, "a positive diameter in m");
+        sc.diameter_spread = f.get_double(S + "Diameter spread");
+        sc.density         = f.get_checked(S + "Density", positive, "a positive density in kg/m^3");
+        sc.length          = f.get_checked(S + "Length", positive, "a positive length in m");
+        const double d_max = sc.mean_diameter * (1 + sc.diameter_spread);
+        if (sc.length < 8 * d_max)
+          f.fail(S + "Length", "a length of at least 8 largest diameters (" + to_text(8 * d_max) + " m)");
+        sc.wall_discs = f.get_integer(S + "Wall discs");
+        if (sc.wall_discs > 0 && sc.wall_discs * sc.mean_diameter * (1 - sc.diameter_spread) > sc.length)
+          f.fail(S + "Wall discs", "at most " + std::to_string(int(sc.length / (sc.mean_diameter * (1 - sc.diameter_spread)))) +
+                                     " discs, so that they fit along the length without overlapping");
+        sc.pressure  = f.get_checked(S + "Pressure", positive, "a positive pressure in Pa");
+        sc.ramp_time = f.get_checked(S + "Pressure ramp time", non_negative, "a time >= 0 in s");
+        sc.sliding_velocity = f.get_checked(S + "Sliding velocity", [](double v) { return std::isfinite(v); }, "a velocity in m/s");
+        sc.shear_start = f.get_checked(S + "Shear start", non_negative, "a time >= 0 in s");
+        if (sc.shear_start >= p.end_time)
+          f.fail(S + "Shear start", "a time before Simulation/End time (" + to_text(p.end_time) + " s)");
+        sc.upper_body_thickness = f.get_checked(S + "Upper body thickness", positive, "a positive thickness in m");
+        sc.profile_samples = f.get_integer(S + "Profile samples");
+        sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");
+        sc.seed = f.get_integer(S + "Seed");
       }
     return p;
   }

@@ -37,6 +37,26 @@ namespace tribo::app
     unsigned int seed;
   };
 
+  /// The third-body shear cell of Cao et al. 2011: a periodic layer of discs
+  /// between a rough lower wall driven at V and a rough upper wall under P.
+  struct ShearCellParameters
+  {
+    unsigned int n_discs;
+    double       mean_diameter;        ///< d, m
+    double       diameter_spread;      ///< relative half-width: d in [d(1-s), d(1+s)]
+    double       density;              ///< kg/m^3
+    double       length;               ///< period L along x, m
+    unsigned int wall_discs;           ///< discs per wall (0: L/d)
+    double       pressure;             ///< P, Pa; force P L (N/m) on the upper wall
+    double       ramp_time;            ///< s over which P rises linearly from 0
+    double       sliding_velocity;     ///< V of the lower wall along x, m/s
+    double       shear_start;          ///< s: compaction before, shearing after
+    double       upper_body_thickness; ///< m: upper wall mass = density * thickness * L
+    unsigned int profile_samples;      ///< profile samples over the shearing phase
+    double       layer_thickness;      ///< profile layer thickness, m (0: d)
+    unsigned int seed;
+  };
+
   struct CaseParameters
   {
     std::string scene;
@@ -50,6 +70,7 @@ namespace tribo::app
     unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)
     CollisionParameters  collision;
     CompactionParameters compaction;
+    ShearCellParameters  shear;
   };
 
   /// Declare every entry of a case file.

@@ -143,7 +143,7 @@ namespace tribo::app
       {
         fs::create_directories(dir / "fields");
         for (const char *name : {"statistics.csv", "results.h5", "summary.json", "log.txt",
-                                 "original.prm", "parameters.prm"})
+                                 "original.prm", "parameters.prm", "profiles.csv"})
           fs::remove(dir / name);
         for (const auto &entry : fs::directory_iterator(dir / "fields"))
           fs::remove(entry.path());
@@ -207,6 +207,7 @@ namespace tribo::app
     double        worst_overlap = 0, t = 0, max_residual = 0;
     ProgressLine  progress(n_steps * h, !o.quiet);
     auto          last_flush = std::chrono::steady_clock::now();
+    std::vector<double> last_row;
     try
       {
         for (; step < n_steps; )
@@ -234,17 +235,15 @@ namespace tribo::app
                 log(os.str());
               }
             const std::vector<double> extra = scene->measure(system, mj, r);
-            const bool last = step == n_steps || scene->finished();
+            const bool stopping = stop_requested() != 0;
+            const bool last     = step == n_steps || scene->finished() || stopping;
+            last_row = {t, double(step), double(r.n_contacts), double(r.n_active),
+                        double(r.solver.iterations), r.solver.residual,
+                        r.solver.converged ? 1.0 : 0.0, r.epsilon, r.max_overlap,
+                        r.kinetic_energy, r.power_external, r.power_free, r.power_contacts};
+            last_row.insert(last_row.end(), extra.begin(), extra.end());
             if (step % p.statistics_interval == 0 || last)
-              {
-                std::vector<double> row = {t, double(step), double(r.n_contacts), double(r.n_active),
-                                           double(r.solver.iterations), r.solver.residual,
-                                           r.solver.converged ? 1.0 : 0.0, r.epsilon, r.max_overlap,
-                                           r.kinetic_energy, r.power_external, r.power_free,
-                                           r.power_contacts};
-                row.insert(row.end(), extra.begin(), extra.end());
-                stats.add_row(row);
-              }
+              stats.add_row(last_row);
             if (p.field_interval > 0 && step % p.field_interval == 0 && !last)
               write_fields(fields, t, system, mj, h);
             const auto now = std::chrono::steady_clock::now();
@@ -254,6 +253,11 @@ namespace tribo::app
                 last_flush = now;
               }
             progress.update(t, step);
+            if (stopping)
+              {
+                status = "interrupted";
+                break;
+              }
             if (scene->finished())
               break;
           }
@@ -262,6 +266,9 @@ namespace tribo::app
       {
         status  = "failed";
         failure = e.what();
+        // The last completed step gets its row, whatever the interval.
+        if (!last_row.empty() && (stats.rows().empty() || stats.rows().back()[1] != last_row[1]))
+          stats.add_row(last_row);
       }
     progress.finish();
     write_fields(fields, t, system, mj, h);
@@ -297,7 +304,10 @@ namespace tribo::app
                                              {"simulated_time", t}, {"wall_time", wall},
                                              {"complete", status == "complete" ? 1.0 : 0.0}};
     atomic_write((dir / "statistics.csv").string(), stats.to_csv());
-    write_results_h5((dir / "results.h5").string(), stats, resolved, scalars);
+    const auto tables = scene->tables();
+    for (const auto &[name, table] : tables)
+      atomic_write((dir / (name + ".csv")).string(), table.to_csv());
+    write_results_h5((dir / "results.h5").string(), stats, tables, resolved, scalars);
     atomic_write((dir / "summary.json").string(), summary.to_string());
 
     std::ostringstream os;

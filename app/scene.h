@@ -7,6 +7,7 @@
 #include "dem/moreau_jean.h"
 #include "dem/particle_system.h"
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,7 +31,9 @@ namespace tribo::app
     /// True when the scene's event is over (the run then ends before End time).
     virtual bool finished() const { return false; }
     /// Scene results for summary.json, from the state and the statistics.
-    virtual void summarize(const dem::ParticleSystem &, const TimeSeries &, JsonObject &) const {}
+    virtual void summarize(const dem::ParticleSystem &, const TimeSeries &, JsonObject &) {}
+    /// Extra tables, written as NAME.csv and as the HDF5 group NAME (after summarize()).
+    virtual std::map<std::string, TimeSeries> tables() const { return {}; }
 
   protected:
     explicit Scene(const CaseParameters &p) : prm(p) {}

@@ -78,7 +78,7 @@ namespace tribo::app
                 mj.external_power().empty() ? 0.0 : mj.external_power()[upper]};
       }
 
-      void summarize(const dem::ParticleSystem &s, const TimeSeries &stats, JsonObject &j) const override
+      void summarize(const dem::ParticleSystem &s, const TimeSeries &stats, JsonObject &j) override
       {
         // Mean lower-wall force over the last fifth of the rows.
         const auto   fl = stats.column("lower_wall_normal_force");

@@ -1,6 +1,7 @@
 #pragma once
 /// @file Errors reported to users and the exit codes of `tribo`.
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -21,6 +22,14 @@ namespace tribo
   public:
     using std::runtime_error::runtime_error;
   };
+
+  /// A number for a message, with 6 significant digits ("6e-06", not "0.000006").
+  inline std::string to_text(double v)
+  {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+  }
 
   /// Exit codes of `tribo`; an interrupted run exits with 128 + signal number.
   enum ExitCode : int

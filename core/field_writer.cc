@@ -3,6 +3,7 @@
 #include "core/output.h"
 
 #include <deal.II/base/data_out_base.h>
+#include <deal.II/grid/reference_cell.h>
 
 #include <cstdio>
 #include <sstream>
@@ -14,10 +15,35 @@ namespace tribo
     using Interpretation = dealii::DataComponentInterpretation::DataComponentInterpretation;
     using Ranges         = std::vector<std::tuple<unsigned int, unsigned int, std::string, Interpretation>>;
 
+    /// A valid VTU with no points (deal.II writes no <Points> element for no patches).
+    std::string empty_vtu(const std::vector<std::string> &names)
+    {
+      std::ostringstream os;
+      os << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+            "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"0\" "
+            "NumberOfCells=\"0\">\n<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+            "format=\"ascii\"></DataArray></Points>\n<Cells>"
+            "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\"></DataArray>"
+            "<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\"></DataArray>"
+            "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\"></DataArray></Cells>\n<PointData>";
+      for (const auto &n : names)
+        os << "<DataArray type=\"Float32\" Name=\"" << n << "\" format=\"ascii\"></DataArray>";
+      os << "</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+      return os.str();
+    }
+
     template <typename Patches>
     std::string vtu_text_of(const Patches &patches, const std::vector<std::string> &names,
                             const Ranges &ranges)
     {
+      if (patches.empty())
+        {
+          std::vector<std::string> unique;
+          for (const auto &n : names)
+            if (unique.empty() || unique.back() != n)
+              unique.push_back(n);
+          return empty_vtu(unique);
+        }
       dealii::DataOutBase::VtkFlags flags;
       flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
       std::ostringstream os;
@@ -72,7 +98,8 @@ namespace tribo
         auto &p       = contact_patches[i];
         p.vertices[0] = dealii::Point<2>(contacts.x0[i], contacts.y0[i]);
         p.vertices[1] = dealii::Point<2>(contacts.x1[i], contacts.y1[i]);
-        p.patch_index = i;
+        p.patch_index    = i;
+        p.reference_cell = dealii::ReferenceCells::Line; // not set by default in deal.II 9.4
         p.data.reinit(3, 2);
         for (unsigned int v = 0; v < 2; ++v)
           {

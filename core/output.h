@@ -67,9 +67,11 @@ namespace tribo
   };
 
   /// Write results.h5 (atomically): group "statistics" with one dataset per
-  /// column, group "parameters" with every resolved entry as a string
-  /// attribute (keyed by its path), and @p scalars as attributes of the root.
+  /// column, one group per extra table (e.g. "profiles") likewise, group
+  /// "parameters" with every resolved entry as a string attribute (keyed by its
+  /// path), and @p scalars as attributes of the root.
   void write_results_h5(const std::string &path, const TimeSeries &statistics,
+                        const std::map<std::string, TimeSeries> &tables,
                         const std::map<std::string, std::string> &parameters,
                         const std::map<std::string, double> &scalars);
 

@@ -4,6 +4,7 @@
 
 #include <deal.II/base/exceptions.h>
 
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -52,6 +53,9 @@ namespace tribo
   void ParameterFile::parse(const std::string &filename)
   {
     file = filename;
+    std::error_code ec;
+    if (std::filesystem::exists(filename, ec) && !std::filesystem::is_regular_file(filename, ec))
+      throw InputError(filename + ": not a regular file (expected a .prm parameter file)");
     std::ifstream in(filename);
     if (!in)
       throw InputError(filename + ": cannot open the parameter file (missing or unreadable)");
@@ -91,7 +95,23 @@ namespace tribo
       }
     catch (const dealii::ParameterHandler::ExcInvalidEntryForPattern &e)
       {
-        throw InputError(filename + ": " + describe(e));
+        // deal.II: "Line <N> of file <F>: The entry value <V> for the entry named
+        // <E> does not match the given pattern <P>." -> our FILE:LINE form with the path.
+        static const std::regex re("Line <(\\d+)> of file <[^>]*>: The entry value <(.*)> for the entry "
+                                   "named <(.*)> does not match the given pattern <(.*)>\\.?");
+        const std::string info = describe(e);
+        std::smatch       m;
+        if (std::regex_match(info, m, re))
+          {
+            const unsigned int line = std::stoul(m[1]);
+            std::string        path = m[3];
+            for (const auto &[p, l] : lines)
+              if (l == line)
+                path = p;
+            throw InputError(filename + ":" + std::to_string(line) + ": entry '" + path + "' = '" +
+                             std::string(m[2]) + "': expected a value matching " + std::string(m[4]));
+          }
+        throw InputError(filename + ": " + info);
       }
     catch (const dealii::ExceptionBase &e)
       {
@@ -106,7 +126,9 @@ namespace tribo
       throw InputError("--set '" + assignment + "': expected \"Subsection/Entry=value\"");
     const std::string path  = trim(assignment.substr(0, eq));
     const std::string value = trim(assignment.substr(eq + 1));
-    auto              parts = split_path(path);
+    auto parts = split_path(path);
+    if (parts.empty() || parts.back().empty() || value.empty())
+      throw InputError("--set '" + assignment + "': expected \"Subsection/Entry=value\"");
     const std::string entry = parts.back();
     parts.pop_back();
     unsigned int depth = 0;

@@ -9,6 +9,7 @@
 namespace tribo
 {
   void write_results_h5(const std::string &path, const TimeSeries &statistics,
+                        const std::map<std::string, TimeSeries> &tables,
                         const std::map<std::string, std::string> &parameters,
                         const std::map<std::string, double> &scalars)
   {
@@ -19,15 +20,19 @@ namespace tribo
         for (const auto &[name, value] : scalars)
           file.set_attribute(name, value);
 
-        auto group = file.create_group("statistics");
-        for (const auto &name : statistics.columns())
-          {
-            const std::vector<double> values = statistics.column(name);
-            if (values.empty())
-              continue; // HDF5 datasets cannot be empty through this wrapper
-            group.write_dataset(name, values);
-          }
-        group.set_attribute("n_rows", static_cast<unsigned int>(statistics.rows().size()));
+        const auto write_table = [&](const std::string &name, const TimeSeries &table) {
+          auto group = file.create_group(name);
+          for (const auto &column : table.columns())
+            {
+              const std::vector<double> values = table.column(column);
+              if (!values.empty()) // the wrapper cannot write empty datasets
+                group.write_dataset(column, values);
+            }
+          group.set_attribute("n_rows", static_cast<unsigned int>(table.rows().size()));
+        };
+        write_table("statistics", statistics);
+        for (const auto &[name, table] : tables)
+          write_table(name, table);
 
         auto prm = file.create_group("parameters");
         for (const auto &[name, value] : parameters)

@@ -30,9 +30,9 @@ namespace tribo::dem
     if (periodic)
       {
         if (system.period < 2 * reach)
-          throw RunError("the period along x (" + std::to_string(system.period) +
+          throw RunError("the period along x (" + to_text(system.period) +
                          " m) is shorter than two contact reaches (" +
-                         std::to_string(2 * reach) + " m): enlarge the domain");
+                         to_text(2 * reach) + " m): enlarge the domain");
         xmin = 0;
         xmax = system.period;
       }

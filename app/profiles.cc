@@ -1,0 +1,158 @@
+#include "app/profiles.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tribo::app
+{
+  namespace
+  {
+    enum Quantity
+    {
+      q_vx,
+      q_solid_fraction,
+      q_sxx,
+      q_syy,
+      q_sxy,
+      q_syx,
+      q_count,
+      n_quantities
+    };
+
+    /// Area of the part of a disc (radius r, centre at 0) below the line y = s.
+    double area_below(double s, double r)
+    {
+      if (s <= -r)
+        return 0;
+      if (s >= r)
+        return M_PI * r * r;
+      return r * r * std::acos(-s / r) + s * std::sqrt(r * r - s * s);
+    }
+  } // namespace
+
+  double disc_area_between(double yc, double r, double a, double b)
+  {
+    return area_below(b - yc, r) - area_below(a - yc, r);
+  }
+
+  const std::vector<std::string> &LayerProfiles::quantity_names()
+  {
+    static const std::vector<std::string> names = {"vx", "solid_fraction", "sigma_xx", "sigma_yy",
+                                                   "sigma_xy", "sigma_yx", "n_discs"};
+    return names;
+  }
+
+  std::vector<std::string> LayerProfiles::average_columns()
+  {
+    std::vector<std::string> c = {"layer", "y", "y_over_h"};
+    for (const auto &n : quantity_names())
+      c.push_back(n);
+    c.push_back("n_samples");
+    return c;
+  }
+
+  LayerProfiles::LayerProfiles(unsigned int lower, unsigned int upper, double wall_inset,
+                               double layer_target)
+    : lower(lower)
+    , upper(upper)
+    , inset(wall_inset)
+    , target(layer_target)
+  {}
+
+  void LayerProfiles::sample(double t, const dem::ParticleSystem &s, const dem::MoreauJean &mj, double h)
+  {
+    const double y_l = s.bodies[lower].position.y() + inset, y_u = s.bodies[upper].position.y() - inset;
+    const double H   = y_u - y_l;
+    if (layers == 0)
+      layers = std::max(1, int(std::lround(H / target)));
+    const double thickness = H / layers;
+    const double length    = s.period;
+    const double area      = thickness * length;
+    std::vector<double> row(layers * n_quantities, 0.0);
+    auto layer_of = [&](double y) { return int(std::floor((y - y_l) / thickness)); };
+    // Grains nestled between wall discs (centre beyond a wall surface) count in the
+    // layer next to that wall.
+    auto grain_layer = [&](double y) { return std::clamp(layer_of(y), 0, int(layers) - 1); };
+
+    // Velocities and areas of the discs.
+    for (std::size_t d = 0; d < s.discs.size(); ++d)
+      {
+        const auto  &disc = s.discs[d];
+        const auto  &body = s.bodies[disc.body];
+        const double yc   = s.disc_centre(d).y();
+        const int    k    = grain_layer(yc);
+        const bool   free = disc.body != lower && disc.body != upper;
+        if (free)
+          {
+            row[k * n_quantities + q_vx] += body.velocity.x();
+            row[k * n_quantities + q_count] += 1;
+          }
+        const int k0 = std::max(0, layer_of(yc - disc.radius)), k1 = std::min(int(layers) - 1, layer_of(yc + disc.radius));
+        for (int j = k0; j <= k1; ++j)
+          row[j * n_quantities + q_solid_fraction] +=
+            disc_area_between(yc, disc.radius, y_l + j * thickness, y_l + (j + 1) * thickness) / area;
+      }
+    for (unsigned int k = 0; k < layers; ++k)
+      if (row[k * n_quantities + q_count] > 0)
+        row[k * n_quantities + q_vx] /= row[k * n_quantities + q_count];
+
+    // Love-Weber stresses: each contact adds -f (x) l / A for each free disc it touches,
+    // in the layer of that disc's centre.
+    for (const auto &c : mj.contacts())
+      {
+        if (c.r.x() == 0 && c.r.y() == 0)
+          continue;
+        const dem::Vec2 t(-c.normal.y(), c.normal.x());
+        const dem::Vec2 f1 = (c.r.x() * c.normal + c.r.y() * t) / h; // on disc 1
+        const dem::Vec2 point_from0 = (s.discs[c.disc[0]].radius + 0.5 * c.gap) * c.normal;
+        for (int side = 0; side < 2; ++side)
+          {
+            const unsigned int b = c.body[side];
+            if (b == lower || b == upper)
+              continue;
+            const dem::Vec2 f = side == 0 ? dem::Vec2(-f1) : f1;
+            const dem::Vec2 l = side == 0 ? point_from0 : dem::Vec2(point_from0 - c.branch);
+            const int       k = grain_layer(s.disc_centre(c.disc[side]).y());
+            row[k * n_quantities + q_sxx] -= f.x() * l.x() / area;
+            row[k * n_quantities + q_syy] -= f.y() * l.y() / area;
+            row[k * n_quantities + q_sxy] -= f.x() * l.y() / area;
+            row[k * n_quantities + q_syx] -= f.y() * l.x() / area;
+          }
+      }
+    times.push_back(t);
+    gap.push_back(H);
+    data.push_back(std::move(row));
+  }
+
+  unsigned int LayerProfiles::n_samples_after(double t_start) const
+  {
+    return std::count_if(times.begin(), times.end(), [&](double t) { return t >= t_start; });
+  }
+
+  std::vector<std::vector<double>> LayerProfiles::average(double t_start) const
+  {
+    std::vector<std::vector<double>> out;
+    const unsigned int               n = n_samples_after(t_start);
+    if (n == 0 || layers == 0)
+      return out;
+    double mean_gap = 0;
+    std::vector<double> sum(layers * n_quantities, 0.0);
+    for (std::size_t i = 0; i < times.size(); ++i)
+      if (times[i] >= t_start)
+        {
+          mean_gap += gap[i] / n;
+          for (std::size_t j = 0; j < sum.size(); ++j)
+            sum[j] += data[i][j] / n;
+        }
+    for (unsigned int k = 0; k < layers; ++k)
+      {
+        const double        y = (k + 0.5) * mean_gap / layers;
+        std::vector<double> r = {double(k), y, y / mean_gap};
+        for (int q = 0; q < n_quantities; ++q)
+          r.push_back(sum[k * n_quantities + q]);
+        r.push_back(n);
+        out.push_back(r);
+      }
+    return out;
+  }
+} // namespace tribo::app

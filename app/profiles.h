@@ -1,0 +1,64 @@
+#pragma once
+/// @file Profiles across the gap of a shear cell: layers parallel to the walls,
+/// sampled at chosen times and averaged over the samples of the steady state.
+///
+/// The gap between the wall surfaces, from y_L + a to y_U - a (y_L, y_U the wall
+/// centre lines, a the mean wall-disc radius), is cut into n layers of equal
+/// thickness, n fixed at the first sample (about one mean diameter each).
+/// Per layer and sample:
+/// - vx: mean x-velocity of the free discs whose centre lies in the layer
+///   (Cao et al. 2011 eq. 14; grains whose centre is beyond a wall surface,
+///   nestled between wall discs, count in the layer next to that wall), m/s;
+/// - solid_fraction: area of all discs inside the layer / layer area (exact
+///   circle-strip areas, walls included);
+/// - stress: Love-Weber average over the layer, sigma = -(1/A) sum_P sum_c f_c (x) l_c,
+///   with f_c the contact force on free disc P and l_c from P's centre to the
+///   contact point: Cao et al. eq. (15) with vol(P) replaced by P's share of the
+///   layer area, so that equilibrium gives sigma_yy = P. Compression positive, Pa.
+///   sigma_xy is the x-force transmitted across a horizontal plane per unit length.
+
+#include "dem/moreau_jean.h"
+#include "dem/particle_system.h"
+
+#include <string>
+#include <vector>
+
+namespace tribo::app
+{
+  class LayerProfiles
+  {
+  public:
+    /// Quantities per layer, in this order in every sample.
+    static const std::vector<std::string> &quantity_names();
+
+    /// @p lower, @p upper: the wall bodies; @p wall_inset: a, m; @p layer_target:
+    /// wanted layer thickness, m.
+    LayerProfiles(unsigned int lower, unsigned int upper, double wall_inset, double layer_target);
+
+    /// Record one sample at time @p t from the state after a step of length @p h.
+    void sample(double t, const dem::ParticleSystem &system, const dem::MoreauJean &mj, double h);
+
+    /// Mean over the samples with time >= @p t_start: one row per layer,
+    /// columns: layer, y (layer centre above the lower wall surface, m), y_over_h
+    /// (y over the gap between the wall surfaces), then quantity_names(), n_samples.
+    std::vector<std::vector<double>> average(double t_start) const;
+    static std::vector<std::string> average_columns();
+
+    unsigned int n_layers() const { return layers; }
+    unsigned int n_samples() const { return times.size(); }
+    unsigned int n_samples_after(double t_start) const;
+
+  private:
+    unsigned int lower, upper;
+    double       inset, target;
+    unsigned int layers = 0;
+    std::vector<double> times;
+    std::vector<double> gap;       ///< gap between the wall surfaces per sample, m
+    /// data[sample][layer * n_quantities + q]
+    std::vector<std::vector<double>> data;
+  };
+
+  /// Area (m^2) of the disc of radius @p r centred at height @p yc between the
+  /// horizontal lines y = @p a and y = @p b (a < b).
+  double disc_area_between(double yc, double r, double a, double b);
+} // namespace tribo::app

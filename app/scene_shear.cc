@@ -1,0 +1,219 @@
+// The third-body shear cell (Cao, Renouf, Dubois, Berthier 2011, Fig. 3a):
+// a layer of discs, periodic along x, between two rough walls (clumps of discs).
+// The lower wall is fixed until `Shear start`, then slides at V along x (fixed in
+// y and rotation); the upper wall carries the pressure P (force P L per unit
+// depth, ramped), is free in y only, and has the mass of the first body it
+// stands for. Before `Shear start` the layer compacts under P.
+#include "app/profiles.h"
+#include "app/scene.h"
+#include "app/steady_state.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace tribo::app
+{
+  namespace
+  {
+    class ShearCellScene : public Scene
+    {
+    public:
+      explicit ShearCellScene(const CaseParameters &p)
+        : Scene(p)
+        , rng(p.shear.seed)
+      {}
+
+      void build(dem::ParticleSystem &s) override
+      {
+        const auto  &k     = prm.shear;
+        const double d_max = k.mean_diameter * (1 + k.diameter_spread);
+        s.period           = k.length;
+
+        lower = add_wall(s, 0.0);
+        for (auto &d : s.bodies[lower].drive)
+          d = dem::Drive::velocity;
+
+        // Grains on a loose triangular lattice (neighbours 1.02 d_max apart).
+        const double       pitch   = 1.02 * d_max;
+        const unsigned int columns = std::max(1u, unsigned(k.length / pitch));
+        const double       dx      = k.length / columns;
+        const double       dy      = std::sqrt(std::max(pitch * pitch - 0.25 * dx * dx, 0.0));
+        const unsigned int rows    = (k.n_discs + columns - 1) / columns;
+        for (unsigned int i = 0; i < k.n_discs; ++i)
+          {
+            const unsigned int row = i / columns;
+            s.add_disc({(i % columns + 0.5 + 0.5 * (row % 2)) * dx, d_max + 0.5 * pitch + row * dy},
+                       0.5 * draw_diameter(), k.density);
+          }
+
+        upper = add_wall(s, d_max + 0.5 * pitch + (rows - 1) * dy + pitch);
+        auto &u = s.bodies[upper];
+        u.drive = {{dem::Drive::velocity, dem::Drive::force, dem::Drive::velocity}};
+        const double discs_mass = u.mass;
+        u.mass                  = k.density * k.upper_body_thickness * k.length;
+        u.inertia *= u.mass / discs_mass;
+
+        profiles = std::make_unique<LayerProfiles>(
+          lower, upper, 0.5 * mean_wall_diameter, k.layer_thickness > 0 ? k.layer_thickness : k.mean_diameter);
+        mean_grain_diameter = 0;
+        for (const auto &d : s.discs)
+          if (d.body != lower && d.body != upper)
+            mean_grain_diameter += 2 * d.radius / k.n_discs;
+      }
+
+      void before_step(dem::ParticleSystem &s, unsigned long step) override
+      {
+        const auto  &k    = prm.shear;
+        const double t    = step * prm.time_step;
+        const double ramp = k.ramp_time > 0 ? std::min(1.0, (t + prm.time_step) / k.ramp_time) : 1.0;
+        s.bodies[upper].load[1]      = -ramp * k.pressure * k.length;
+        s.bodies[lower].velocity.x() = t >= k.shear_start ? k.sliding_velocity : 0.0;
+      }
+
+      std::vector<std::string> columns() const override
+      {
+        return {"mu", "normal_force", "lower_wall_normal_force", "upper_wall_y", "upper_wall_vy",
+                "gap", "power_lower_wall", "power_upper_wall", "power_dissipated",
+                "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction"};
+      }
+
+      std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
+                                  const dem::StepReport &r) override
+      {
+        ++steps_done;
+        const double t     = steps_done * prm.time_step;
+        const auto  &f     = mj.contact_force();
+        const auto  &power = mj.external_power();
+        const double F     = -s.bodies[upper].load[1];
+        double       ke_tb = 0;
+        for (std::size_t b = 0; b < s.bodies.size(); ++b)
+          if (b != lower && b != upper)
+            ke_tb += s.bodies[b].kinetic_energy();
+        const double gap = s.bodies[upper].position.y() - s.bodies[lower].position.y();
+
+        // Profile samples evenly spread over the shearing phase.
+        const auto  &k        = prm.shear;
+        const double interval = (prm.end_time - k.shear_start) / k.profile_samples;
+        if (t >= k.shear_start + (profiles->n_samples() + 0.5) * interval - 0.5 * prm.time_step &&
+            profiles->n_samples() < k.profile_samples)
+          profiles->sample(t, s, mj, prm.time_step);
+
+        return {F > 0 ? -f[lower].x() / F : 0.0,
+                F,
+                -f[lower].y(),
+                s.bodies[upper].position.y(),
+                s.bodies[upper].velocity.y(),
+                gap,
+                power[lower],
+                power[upper],
+                -r.power_contacts,
+                ke_tb,
+                s.bodies[upper].kinetic_energy(),
+                grain_area(s) / ((gap - mean_wall_diameter) * k.length)};
+      }
+
+      void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
+      {
+        const auto &k    = prm.shear;
+        const auto  time = stats.column("time");
+        const auto  mu   = stats.column("mu");
+        const auto  ke   = stats.column("kinetic_energy");
+        const double t1  = time.empty() ? 0 : time.back();
+        j.set("sliding", t1 > k.shear_start);
+        if (t1 <= k.shear_start)
+          return;
+        steady = detect_steady_state(time, {mu, ke}, k.shear_start, t1, 0.1, {0.01, 0.0});
+        j.set("steady_state_reached", steady.reached);
+        j.set("steady_state_start", steady.start);
+        const auto stat = [&](const std::string &name) { return mean_and_std(time, stats.column(name), steady.start); };
+        const auto [mu_mean, mu_std] = stat("mu");
+        j.set("mu_mean", mu_mean);
+        j.set("mu_std", mu_std);
+        const double p_lb = stat("power_lower_wall").first, p_ub = stat("power_upper_wall").first;
+        const double p_diss = stat("power_dissipated").first;
+        j.set("power_lower_wall_mean", p_lb);
+        j.set("power_upper_wall_mean", p_ub);
+        j.set("power_dissipated_mean", p_diss);
+        j.set("power_third_body_mean", stat("power_free").first);
+        j.set("power_balance_ratio", p_lb != 0 ? p_diss / p_lb : NAN);
+        j.set("normal_force_mean", stat("lower_wall_normal_force").first);
+        j.set("normal_force_target", k.pressure * k.length);
+        const double h_tb = stat("gap").first - mean_wall_diameter;
+        j.set("third_body_thickness", h_tb);
+        j.set("solid_fraction_mean", stat("solid_fraction").first);
+        j.set("inertial_number", k.sliding_velocity / h_tb * mean_grain_diameter *
+                                   std::sqrt(k.density / k.pressure));
+        j.set("cohesion_number", prm.law.cohesion / (k.pressure * mean_grain_diameter));
+        j.set("profile_samples_in_steady_state", long(profiles->n_samples_after(steady.start)));
+
+        // Mean stresses over the layers at least two layers away from the walls.
+        const auto rows = profiles->average(steady.start);
+        const auto cols = LayerProfiles::average_columns();
+        for (const std::string q : {"sigma_xx", "sigma_yy", "sigma_xy"})
+          {
+            const auto c   = std::find(cols.begin(), cols.end(), q) - cols.begin();
+            double     sum = 0;
+            int        n   = 0;
+            for (std::size_t i = 2; i + 2 < rows.size(); ++i, ++n)
+              sum += rows[i][c];
+            j.set(q + "_mean", n ? sum / n : NAN);
+          }
+      }
+
+      std::map<std::string, TimeSeries> tables() const override
+      {
+        TimeSeries table(LayerProfiles::average_columns());
+        for (const auto &row : profiles->average(steady.start))
+          table.add_row(row);
+        return {{"profiles", table}};
+      }
+
+    private:
+      double draw_diameter()
+      {
+        const auto &k = prm.shear;
+        std::uniform_real_distribution<double> u(1 - k.diameter_spread, 1 + k.diameter_spread);
+        return k.mean_diameter * u(rng);
+      }
+
+      /// A rough wall: discs of drawn sizes spread evenly along the period at height y.
+      unsigned int add_wall(dem::ParticleSystem &s, double y)
+      {
+        const auto        &k = prm.shear;
+        const unsigned int n = k.wall_discs > 0 ? k.wall_discs
+                                                : std::max(1u, unsigned(std::round(k.length / k.mean_diameter)));
+        std::vector<double>    radii(n);
+        std::vector<dem::Vec2> centres(n);
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            radii[i]   = 0.5 * draw_diameter();
+            centres[i] = {(i + 0.5) * k.length / n, y};
+            mean_wall_diameter += radii[i] / n; // two walls: mean of their diameters
+          }
+        return s.add_clump(centres, radii, k.density);
+      }
+
+      double grain_area(const dem::ParticleSystem &s) const
+      {
+        double a = 0;
+        for (const auto &d : s.discs)
+          if (d.body != lower && d.body != upper)
+            a += M_PI * d.radius * d.radius;
+        return a;
+      }
+
+      std::mt19937                   rng;
+      unsigned int                   lower = 0, upper = 0;
+      unsigned long                  steps_done = 0;
+      double                         mean_wall_diameter = 0, mean_grain_diameter = 0;
+      std::unique_ptr<LayerProfiles> profiles;
+      SteadyState                    steady;
+    };
+  } // namespace
+
+  std::unique_ptr<Scene> make_shear_scene(const CaseParameters &p)
+  {
+    return std::make_unique<ShearCellScene>(p);
+  }
+} // namespace tribo::app

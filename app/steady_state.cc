@@ -1,0 +1,64 @@
+#include "app/steady_state.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tribo::app
+{
+  namespace
+  {
+    double mean_between(const std::vector<double> &time, const std::vector<double> &v, double a, double b)
+    {
+      double sum = 0;
+      int    n   = 0;
+      for (std::size_t i = 0; i < time.size(); ++i)
+        if (time[i] >= a && time[i] < b)
+          {
+            sum += v[i];
+            ++n;
+          }
+      return n ? sum / n : NAN;
+    }
+  } // namespace
+
+  SteadyState detect_steady_state(const std::vector<double> &time,
+                                  const std::vector<std::vector<double>> &series, double t0, double t1,
+                                  double tolerance, const std::vector<double> &absolute)
+  {
+    for (int k = 0; k <= 5; ++k)
+      {
+        const double s   = t0 + k * (t1 - t0) / 10;
+        const double mid = 0.5 * (s + t1);
+        bool         ok  = true;
+        for (std::size_t j = 0; j < series.size() && ok; ++j)
+          {
+            const double a = mean_between(time, series[j], s, mid);
+            const double b = mean_between(time, series[j], mid, t1 + 1e-30 + 1e-12 * std::abs(t1));
+            const double allowed = std::max(tolerance * std::max(std::abs(a), std::abs(b)),
+                                            j < absolute.size() ? absolute[j] : 0.0);
+            ok = std::isfinite(a) && std::isfinite(b) && std::abs(a - b) <= allowed;
+          }
+        if (ok)
+          return {true, s};
+      }
+    return {false, 0.5 * (t0 + t1)};
+  }
+
+  std::pair<double, double> mean_and_std(const std::vector<double> &time, const std::vector<double> &v,
+                                         double start)
+  {
+    double sum = 0, sum2 = 0;
+    int    n   = 0;
+    for (std::size_t i = 0; i < time.size(); ++i)
+      if (time[i] >= start)
+        {
+          sum += v[i];
+          sum2 += v[i] * v[i];
+          ++n;
+        }
+    if (n == 0)
+      return {NAN, NAN};
+    const double m = sum / n;
+    return {m, std::sqrt(std::max(0.0, sum2 / n - m * m))};
+  }
+} // namespace tribo::app
