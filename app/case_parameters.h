@@ -23,20 +23,6 @@ namespace tribo::app
     bool   stop_when_separated;
   };
 
-  /// A layer of discs compacted between two rough walls, periodic in x.
-  struct CompactionParameters
-  {
-    unsigned int n_discs;
-    double       mean_diameter;   ///< m
-    double       diameter_spread; ///< relative half-width: d in [d(1-s), d(1+s)]
-    double       density;         ///< kg/m^3
-    double       length;          ///< period along x, m
-    double       pressure;        ///< Pa, applied as P L (N/m) on the upper wall
-    unsigned int ramp_steps;      ///< steps over which P grows linearly from 0
-    double       upper_body_thickness; ///< m: upper wall mass = density * thickness * L
-    unsigned int seed;
-  };
-
   /// The third-body shear cell of Cao et al. 2011: a periodic layer of discs
   /// between a rough lower wall driven at V and a rough upper wall under P.
   struct ShearCellParameters
@@ -68,8 +54,8 @@ namespace tribo::app
     dem::NlgsParameters solver;
     unsigned int statistics_interval; ///< steps between rows of statistics.csv
     unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)
+    bool         plots;               ///< PNG plots of a shear run (scripts/plot_run.py)
     CollisionParameters  collision;
-    CompactionParameters compaction;
     ShearCellParameters  shear;
   };
 

@@ -11,6 +11,7 @@
 #include <boost/property_tree/ptree.hpp>
 
 #include <cctype>
+#include <cstdlib>
 #include <chrono>
 #include <iostream>
 #include <map>
@@ -143,7 +144,8 @@ namespace tribo::app
       {
         fs::create_directories(dir / "fields");
         for (const char *name : {"statistics.csv", "results.h5", "summary.json", "log.txt",
-                                 "original.prm", "parameters.prm", "profiles.csv"})
+                                 "original.prm", "parameters.prm", "profiles.csv", "mu.png",
+                                 "power.png", "profiles.png"})
           fs::remove(dir / name);
         for (const auto &entry : fs::directory_iterator(dir / "fields"))
           fs::remove(entry.path());
@@ -309,6 +311,16 @@ namespace tribo::app
       atomic_write((dir / (name + ".csv")).string(), table.to_csv());
     write_results_h5((dir / "results.h5").string(), stats, tables, resolved, scalars);
     atomic_write((dir / "summary.json").string(), summary.to_string());
+
+    if (p.plots && p.scene == "shear" && status != "failed" && !stats.rows().empty())
+      {
+        // Plots are a convenience: a missing matplotlib is a warning, not a failure.
+        const std::string command = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR +
+                                    "/scripts/plot_run.py '" + dir.string() + "' >> '" +
+                                    (dir / "log.txt").string() + "' 2>&1";
+        if (std::system(command.c_str()) != 0)
+          log("warning: the plots could not be made (" + command + ")");
+      }
 
     std::ostringstream os;
     os << "status " << status << ": " << step << " steps in " << wall << " s, "

@@ -3,7 +3,8 @@
 // The lower wall is fixed until `Shear start`, then slides at V along x (fixed in
 // y and rotation); the upper wall carries the pressure P (force P L per unit
 // depth, ramped), is free in y only, and has the mass of the first body it
-// stands for. Before `Shear start` the layer compacts under P.
+// stands for. Before `Shear start` the layer compacts under P; a Shear start at
+// or after the End time gives a compaction-only run.
 #include "app/profiles.h"
 #include "app/scene.h"
 #include "app/steady_state.h"
@@ -95,7 +96,7 @@ namespace tribo::app
         // Profile samples evenly spread over the shearing phase.
         const auto  &k        = prm.shear;
         const double interval = (prm.end_time - k.shear_start) / k.profile_samples;
-        if (t >= k.shear_start + (profiles->n_samples() + 0.5) * interval - 0.5 * prm.time_step &&
+        if (interval > 0 && t >= k.shear_start + (profiles->n_samples() + 0.5) * interval - 0.5 * prm.time_step &&
             profiles->n_samples() < k.profile_samples)
           profiles->sample(t, s, mj, prm.time_step);
 
@@ -115,18 +116,34 @@ namespace tribo::app
 
       void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
       {
-        const auto &k    = prm.shear;
-        const auto  time = stats.column("time");
-        const auto  mu   = stats.column("mu");
-        const auto  ke   = stats.column("kinetic_energy");
-        const double t1  = time.empty() ? 0 : time.back();
-        j.set("sliding", t1 > k.shear_start);
-        if (t1 <= k.shear_start)
+        const auto  &k     = prm.shear;
+        const auto   time  = stats.column("time");
+        const double t1    = time.back();
+        const bool   sliding = t1 > k.shear_start;
+        j.set("sliding", sliding);
+        // Averaging window: the steady state when sliding, else the last fifth (compaction).
+        double start = time.front() + 0.8 * (t1 - time.front());
+        if (sliding)
+          {
+            steady = detect_steady_state(time, {stats.column("mu"), stats.column("kinetic_energy")},
+                                         k.shear_start, t1, 0.1, {0.01, 0.0});
+            start = steady.start;
+            j.set("steady_state_reached", steady.reached);
+            j.set("steady_state_start", steady.start);
+          }
+        else
+          steady.start = t1 + 1; // no profile sample is in a steady state
+        const auto stat = [&](const std::string &name) { return mean_and_std(time, stats.column(name), start); };
+        j.set("averaging_start", start);
+        j.set("normal_force_mean", stat("lower_wall_normal_force").first);
+        j.set("normal_force_target", k.pressure * k.length);
+        const double h_tb = stat("gap").first - mean_wall_diameter;
+        j.set("third_body_thickness", h_tb);
+        j.set("solid_fraction_mean", stat("solid_fraction").first);
+        j.set("cohesion_number", prm.law.cohesion / (k.pressure * mean_grain_diameter));
+        if (!sliding)
           return;
-        steady = detect_steady_state(time, {mu, ke}, k.shear_start, t1, 0.1, {0.01, 0.0});
-        j.set("steady_state_reached", steady.reached);
-        j.set("steady_state_start", steady.start);
-        const auto stat = [&](const std::string &name) { return mean_and_std(time, stats.column(name), steady.start); };
+
         const auto [mu_mean, mu_std] = stat("mu");
         j.set("mu_mean", mu_mean);
         j.set("mu_std", mu_std);
@@ -137,14 +154,8 @@ namespace tribo::app
         j.set("power_dissipated_mean", p_diss);
         j.set("power_third_body_mean", stat("power_free").first);
         j.set("power_balance_ratio", p_lb != 0 ? p_diss / p_lb : NAN);
-        j.set("normal_force_mean", stat("lower_wall_normal_force").first);
-        j.set("normal_force_target", k.pressure * k.length);
-        const double h_tb = stat("gap").first - mean_wall_diameter;
-        j.set("third_body_thickness", h_tb);
-        j.set("solid_fraction_mean", stat("solid_fraction").first);
         j.set("inertial_number", k.sliding_velocity / h_tb * mean_grain_diameter *
                                    std::sqrt(k.density / k.pressure));
-        j.set("cohesion_number", prm.law.cohesion / (k.pressure * mean_grain_diameter));
         j.set("profile_samples_in_steady_state", long(profiles->n_samples_after(steady.start)));
 
         // Mean stresses over the layers at least two layers away from the walls.

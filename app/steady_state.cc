@@ -25,7 +25,7 @@ namespace tribo::app
                                   const std::vector<std::vector<double>> &series, double t0, double t1,
                                   double tolerance, const std::vector<double> &absolute)
   {
-    for (int k = 0; k <= 5; ++k)
+    for (int k = 1; k <= 5; ++k)
       {
         const double s   = t0 + k * (t1 - t0) / 10;
         const double mid = 0.5 * (s + t1);

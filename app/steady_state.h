@@ -1,7 +1,7 @@
 #pragma once
 /// @file Detection of the steady state of a sheared layer from its time series.
 ///
-/// Rule: the candidates are the starts s = t0 + k (t1 - t0)/10, k = 0..5, over the
+/// Rule: the candidates are the starts s = t0 + k (t1 - t0)/10, k = 1..5, over the
 /// shearing phase [t0, t1]. The steady state starts at the earliest candidate for
 /// which the rows after s split into two halves (in time) whose means agree, for
 /// every given series, within @p tolerance relative to the larger |mean| (or within

@@ -1,5 +1,5 @@
 // NLGS throughput on a dense packing: compacts a case (default
-// cases/compaction/bench.prm, ~3000 discs at 100 MPa), then times
+// cases/shear/bench.prm, ~3000 discs at 100 MPa), then times
 //  (1) fixed sweeps over the frozen contact set: contact updates per second;
 //  (2) full steps at the case's tolerance: sweeps, contacts and wall time per step.
 // Usage: bench_nlgs [CASE.prm] [compaction steps] [timed steps]
@@ -25,7 +25,7 @@ namespace
 
 int main(int argc, char **argv)
 {
-  const std::string case_file     = argc > 1 ? argv[1] : "cases/compaction/bench.prm";
+  const std::string case_file     = argc > 1 ? argv[1] : "cases/shear/bench.prm";
   const unsigned    compact_steps = argc > 2 ? std::stoul(argv[2]) : 3000;
   const unsigned    timed_steps   = argc > 3 ? std::stoul(argv[3]) : 100;
 
