@@ -1,6 +1,9 @@
 // tribo: the command-line front end.
 #include "app/run.h"
+#include "app/study.h"
 #include "core/errors.h"
+
+#include <deal.II/base/mpi.h>
 
 #include <cstring>
 #include <iostream>
@@ -16,6 +19,8 @@ Usage:
       Run a case; outputs go to DIR (default output/<case name>), see docs/outputs.md.
   tribo check CASE.prm [--set ...]
       Read and validate a case without running it.
+  tribo study STUDY.prm [--output DIR] [--quiet]
+      Run every combination of a study (app/study.h); in parallel with mpirun -np N.
   tribo params
       Print every parameter with its default, allowed values and unit: a case to start from.
   tribo --help | --version
@@ -50,6 +55,27 @@ int main(int argc, char **argv)
             usage_error("'tribo params' takes no arguments");
           std::cout << tribo::app::parameter_reference();
           return tribo::exit_ok;
+        }
+      if (args[0] == "study")
+        {
+          tribo::app::StudyOptions s;
+          for (std::size_t i = 1; i < args.size(); ++i)
+            {
+              if (args[i] == "--output" && i + 1 < args.size())
+                s.output_dir = args[++i];
+              else if (args[i] == "--quiet")
+                s.quiet = true;
+              else if (!args[i].empty() && args[i][0] == '-')
+                usage_error("unknown option '" + args[i] + "' for 'tribo study'");
+              else if (s.study_file.empty())
+                s.study_file = args[i];
+              else
+                usage_error("more than one study file");
+            }
+          if (s.study_file.empty())
+            usage_error("'tribo study' needs a study file");
+          dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+          return tribo::app::run_study(s);
         }
       if (args[0] != "run" && args[0] != "check")
         usage_error("unknown command '" + args[0] + "'");

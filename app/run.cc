@@ -133,7 +133,8 @@ namespace tribo::app
     const CaseParameters p = read_case_parameters(file);
     if (o.check_only)
       {
-        std::cout << o.case_file << ": OK (scene " << p.scene << ")" << std::endl;
+        if (!o.quiet)
+          std::cout << o.case_file << ": OK (scene " << p.scene << ")" << std::endl;
         return exit_ok;
       }
 
