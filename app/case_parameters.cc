@@ -36,6 +36,11 @@ namespace tribo::app
                       "ELAS normal stiffness k, N/m^2 (force per unit depth per metre of overlap), > 0.");
     prm.declare_entry("Friction coefficient", "0", Double(),
                       "Coulomb friction coefficient between discs, >= 0 (0: frictionless, as in the paper).");
+    prm.declare_entry("Overlap recovery", "0", Double(0, 1),
+                      "IQS only: fraction in [0, 1] of an existing overlap pushed out per step. 0 freezes "
+                      "overlaps as the paper's law does; under high pressure the NLGS's small velocity "
+                      "errors then accumulate into overlaps step after step (docs/laws.md); 0.1 keeps "
+                      "them at the size of one step's error.");
     prm.declare_entry("Detection distance", "0", Double(),
                       "Pairs closer than this gap (m) enter the contact list; 0 picks a tenth of the "
                       "smallest radius. Always at least the cohesion range.");
@@ -52,6 +57,11 @@ namespace tribo::app
     prm.declare_entry("Contact order", "fixed", Selection("fixed|random"),
                       "Order of the local solves: 'fixed' (detection order) or 'random' (shuffled every sweep).");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the random contact order.");
+    prm.declare_entry("Gap tolerance", "0", Double(),
+                      "Extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
+                      "0: off, the established code's norms only): every contact's gap violation "
+                      "theta h max(0, -(u_n + shift)) must be below it. Limits the overlaps that the "
+                      "norms let accumulate under high pressure, at the price of more sweeps.");
     prm.leave_subsection();
 
     prm.enter_subsection("Output");
@@ -93,6 +103,10 @@ namespace tribo::app
     prm.declare_entry("Shear start", "1e-5", Double(),
                       "Time at which the lower wall starts sliding, s (>= 0): compaction before; at or after "
                       "Simulation/End time the run only compacts.");
+    prm.declare_entry("Compaction speed limit", "1", Double(),
+                      "Before Shear start, the upper wall's vertical speed is capped at this value, m/s "
+                      "(>= 0; 0: no cap), so that the compaction stroke under P cannot hit the grains "
+                      "at tens of m/s and tunnel into the layer. Not applied while shearing.");
     prm.declare_entry("Upper body thickness", "1.5e-4", Double(),
                       "Thickness of the first body the upper wall stands for, m (> 0; paper: 1.5e-4): "
                       "its mass is density * thickness * L.");
@@ -122,6 +136,7 @@ namespace tribo::app
     if (p.law.cohesion > 0 && p.law.cohesion_range == 0)
       f.fail("Contact law/Cohesion range", "a positive range in m, since Contact law/Cohesion > 0");
     p.law.stiffness = f.get_checked("Contact law/Stiffness", positive, "a positive stiffness in N/m^2");
+    p.law.overlap_recovery = f.get_double("Contact law/Overlap recovery");
     p.law.friction  = f.get_checked("Contact law/Friction coefficient", non_negative, "a coefficient >= 0");
     p.detection_distance =
       f.get_checked("Contact law/Detection distance", non_negative, "a distance >= 0 in m");
@@ -134,6 +149,7 @@ namespace tribo::app
     p.solver.max_iterations = f.get_integer("Solver/Maximum iterations");
     p.solver.random_order   = f.get("Solver/Contact order") == "random";
     p.solver.seed           = f.get_integer("Solver/Seed");
+    p.gap_tolerance         = f.get_checked("Solver/Gap tolerance", non_negative, "a fraction >= 0 of the smallest radius");
 
     p.statistics_interval = f.get_integer("Output/Statistics interval");
     p.field_interval      = f.get_integer("Output/Field interval");
@@ -174,6 +190,7 @@ namespace tribo::app
         sc.ramp_time = f.get_checked(S + "Pressure ramp time", non_negative, "a time >= 0 in s");
         sc.sliding_velocity = f.get_checked(S + "Sliding velocity", [](double v) { return std::isfinite(v); }, "a velocity in m/s");
         sc.shear_start = f.get_checked(S + "Shear start", non_negative, "a time >= 0 in s");
+        sc.compaction_speed = f.get_checked(S + "Compaction speed limit", non_negative, "a speed >= 0 in m/s");
         sc.upper_body_thickness = f.get_checked(S + "Upper body thickness", positive, "a positive thickness in m");
         sc.profile_samples = f.get_integer(S + "Profile samples");
         sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");

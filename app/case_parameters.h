@@ -37,6 +37,7 @@ namespace tribo::app
     double       ramp_time;            ///< s over which P rises linearly from 0
     double       sliding_velocity;     ///< V of the lower wall along x, m/s
     double       shear_start;          ///< s: compaction before, shearing after
+    double       compaction_speed;     ///< cap on the upper wall's |v_y| before shear_start, m/s (0: none)
     double       upper_body_thickness; ///< m: upper wall mass = density * thickness * L
     unsigned int profile_samples;      ///< profile samples over the shearing phase
     double       layer_thickness;      ///< profile layer thickness, m (0: d)
@@ -52,6 +53,7 @@ namespace tribo::app
     dem::ContactLaw     law;
     double              detection_distance; ///< m; 0: a tenth of the smallest radius
     dem::NlgsParameters solver;
+    double              gap_tolerance; ///< Solver/Gap tolerance, fraction of the smallest radius
     unsigned int statistics_interval; ///< steps between rows of statistics.csv
     unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)
     bool         plots;               ///< PNG plots of a shear run (scripts/plot_run.py)

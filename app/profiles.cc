@@ -96,8 +96,31 @@ namespace tribo::app
       if (row[k * n_quantities + q_count] > 0)
         row[k * n_quantities + q_vx] /= row[k * n_quantities + q_count];
 
-    // Love-Weber stresses: each contact adds -f (x) l / A for each free disc it touches,
-    // in the layer of that disc's centre.
+    // Love-Weber stresses, spread along the lever arms: each contact adds
+    // -f (x) l / A for each free disc it touches (l from the disc centre to the
+    // contact point), shared among the layers that l crosses in proportion to the
+    // part of its height in each (all in the centre's layer for a horizontal l).
+    // A static layer then carries exactly the force transmitted across its planes.
+    const auto spread = [&](double y0, double y1, const dem::Vec2 &f, const dem::Vec2 &l) {
+      const double c[4] = {-f.x() * l.x() / area, -f.y() * l.y() / area, -f.x() * l.y() / area,
+                           -f.y() * l.x() / area};
+      const double lo = std::min(y0, y1), hi = std::max(y0, y1);
+      const int    k0 = grain_layer(lo), k1 = grain_layer(hi);
+      for (int k = k0; k <= k1; ++k)
+        {
+          double w = 1;
+          if (k1 > k0)
+            {
+              const double a = std::max(lo, k == 0 ? lo : y_l + k * thickness);
+              const double b = std::min(hi, k == int(layers) - 1 ? hi : y_l + (k + 1) * thickness);
+              w              = std::max(0.0, b - a) / (hi - lo);
+            }
+          row[k * n_quantities + q_sxx] += w * c[0];
+          row[k * n_quantities + q_syy] += w * c[1];
+          row[k * n_quantities + q_sxy] += w * c[2];
+          row[k * n_quantities + q_syx] += w * c[3];
+        }
+    };
     for (const auto &c : mj.contacts())
       {
         if (c.r.x() == 0 && c.r.y() == 0)
@@ -110,13 +133,10 @@ namespace tribo::app
             const unsigned int b = c.body[side];
             if (b == lower || b == upper)
               continue;
-            const dem::Vec2 f = side == 0 ? dem::Vec2(-f1) : f1;
-            const dem::Vec2 l = side == 0 ? point_from0 : dem::Vec2(point_from0 - c.branch);
-            const int       k = grain_layer(s.disc_centre(c.disc[side]).y());
-            row[k * n_quantities + q_sxx] -= f.x() * l.x() / area;
-            row[k * n_quantities + q_syy] -= f.y() * l.y() / area;
-            row[k * n_quantities + q_sxy] -= f.x() * l.y() / area;
-            row[k * n_quantities + q_syx] -= f.y() * l.x() / area;
+            const dem::Vec2 f  = side == 0 ? dem::Vec2(-f1) : f1;
+            const dem::Vec2 l  = side == 0 ? point_from0 : dem::Vec2(point_from0 - c.branch);
+            const double    yc = s.disc_centre(c.disc[side]).y();
+            spread(yc, yc + l.y(), f, l);
           }
       }
     times.push_back(t);

@@ -13,9 +13,12 @@
 ///   circle-strip areas, walls included);
 /// - stress: Love-Weber average over the layer, sigma = -(1/A) sum_P sum_c f_c (x) l_c,
 ///   with f_c the contact force on free disc P and l_c from P's centre to the
-///   contact point: Cao et al. eq. (15) with vol(P) replaced by P's share of the
-///   layer area, so that equilibrium gives sigma_yy = P. Compression positive, Pa.
-///   sigma_xy is the x-force transmitted across a horizontal plane per unit length.
+///   contact point (Cao et al. eq. 15 with vol(P) replaced by the layer area A),
+///   each term shared among the layers that its lever arm l_c crosses, in
+///   proportion to the height of l_c in each. A layer in static equilibrium then
+///   carries exactly the mean force transmitted across its horizontal planes:
+///   sigma_yy = P. Compression positive, Pa. sigma_xy: x-force per unit length
+///   transmitted across a horizontal plane.
 
 #include "dem/moreau_jean.h"
 #include "dem/particle_system.h"

@@ -189,7 +189,9 @@ namespace tribo::app
     scene->build(system);
     const double h        = scene->time_step(system);
     const double distance = p.detection_distance > 0 ? p.detection_distance : 0.1 * system.min_radius();
-    dem::MoreauJean mj(p.theta, p.law, p.solver, distance);
+    dem::NlgsParameters solver = p.solver;
+    solver.gap_tolerance       = p.gap_tolerance * system.min_radius();
+    dem::MoreauJean mj(p.theta, p.law, solver, distance);
     const unsigned long n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
     {
       std::ostringstream os;
@@ -317,8 +319,8 @@ namespace tribo::app
       {
         // Plots are a convenience: a missing matplotlib is a warning, not a failure.
         const std::string command = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR +
-                                    "/scripts/plot_run.py '" + dir.string() + "' >> '" +
-                                    (dir / "log.txt").string() + "' 2>&1";
+                                    "/scripts/plot_run.py " + shell_quote(dir.string()) + " >> " +
+                                    shell_quote((dir / "log.txt").string()) + " 2>&1";
         if (std::system(command.c_str()) != 0)
           log("warning: the plots could not be made (" + command + ")");
       }

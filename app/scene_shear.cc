@@ -3,8 +3,9 @@
 // The lower wall is fixed until `Shear start`, then slides at V along x (fixed in
 // y and rotation); the upper wall carries the pressure P (force P L per unit
 // depth, ramped), is free in y only, and has the mass of the first body it
-// stands for. Before `Shear start` the layer compacts under P; a Shear start at
-// or after the End time gives a compaction-only run.
+// stands for. Before `Shear start` the layer compacts under P, with the upper
+// wall's speed capped (Compaction speed limit); a Shear start at or after the End
+// time gives a compaction-only run.
 #include "app/profiles.h"
 #include "app/scene.h"
 #include "app/steady_state.h"
@@ -69,7 +70,12 @@ namespace tribo::app
         const double t    = step * prm.time_step;
         const double ramp = k.ramp_time > 0 ? std::min(1.0, (t + prm.time_step) / k.ramp_time) : 1.0;
         s.bodies[upper].load[1]      = -ramp * k.pressure * k.length;
-        s.bodies[lower].velocity.x() = t >= k.shear_start ? k.sliding_velocity : 0.0;
+        sliding                      = t >= k.shear_start;
+        s.bodies[lower].velocity.x() = sliding ? k.sliding_velocity : 0.0;
+        // Compaction: cap the upper wall's speed (numerical damping, compaction only).
+        auto &vy = s.bodies[upper].velocity.y();
+        if (t < k.shear_start && k.compaction_speed > 0)
+          vy = std::clamp(vy, -k.compaction_speed, k.compaction_speed);
       }
 
       std::vector<std::string> columns() const override
@@ -100,7 +106,9 @@ namespace tribo::app
             profiles->n_samples() < k.profile_samples)
           profiles->sample(t, s, mj, prm.time_step);
 
-        return {F > 0 ? -f[lower].x() / F : 0.0,
+        // mu > 0 when the layer resists the lower wall's sliding, whatever the sign of V.
+        const double direction = k.sliding_velocity < 0 ? -1.0 : 1.0;
+        return {F > 0 ? -direction * f[lower].x() / F : 0.0,
                 F,
                 -f[lower].y(),
                 s.bodies[upper].position.y(),
@@ -119,7 +127,6 @@ namespace tribo::app
         const auto  &k     = prm.shear;
         const auto   time  = stats.column("time");
         const double t1    = time.back();
-        const bool   sliding = t1 > k.shear_start;
         j.set("sliding", sliding);
         // Averaging window: the steady state when sliding, else the last fifth (compaction).
         double start = time.front() + 0.8 * (t1 - time.front());
@@ -154,7 +161,7 @@ namespace tribo::app
         j.set("power_dissipated_mean", p_diss);
         j.set("power_third_body_mean", stat("power_free").first);
         j.set("power_balance_ratio", p_lb != 0 ? p_diss / p_lb : NAN);
-        j.set("inertial_number", k.sliding_velocity / h_tb * mean_grain_diameter *
+        j.set("inertial_number", std::abs(k.sliding_velocity) / h_tb * mean_grain_diameter *
                                    std::sqrt(k.density / k.pressure));
         j.set("profile_samples_in_steady_state", long(profiles->n_samples_after(steady.start)));
 
@@ -217,6 +224,7 @@ namespace tribo::app
       std::mt19937                   rng;
       unsigned int                   lower = 0, upper = 0;
       unsigned long                  steps_done = 0;
+      bool                           sliding    = false; ///< the lower wall has started sliding
       double                         mean_wall_diameter = 0, mean_grain_diameter = 0;
       std::unique_ptr<LayerProfiles> profiles;
       SteadyState                    steady;

@@ -283,8 +283,8 @@ namespace tribo::app
 
     // Overlay plots of the profiles (a convenience: a failure is a warning).
     const std::string command = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR +
-                                "/scripts/plot_study.py '" + dir.string() + "' > '" +
-                                (dir / "plots.log").string() + "' 2>&1";
+                                "/scripts/plot_study.py " + shell_quote(dir.string()) + " > " +
+                                shell_quote((dir / "plots.log").string()) + " 2>&1";
     if (std::system(command.c_str()) != 0 && !o.quiet)
       std::cout << "warning: the study plots could not be made, see " << (dir / "plots.log").string() << std::endl;
     if (!o.quiet)

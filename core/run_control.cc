@@ -19,6 +19,14 @@ namespace tribo
 
   int stop_requested() { return stop_signal; }
 
+  std::string shell_quote(const std::string &s)
+  {
+    std::string q = "'";
+    for (const char c : s)
+      q += (c == '\'' ? std::string("'\\''") : std::string(1, c));
+    return q + "'";
+  }
+
   ProgressLine::ProgressLine(double end_time, bool enabled)
     : end_time(end_time)
     , enabled(enabled)

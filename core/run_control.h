@@ -13,6 +13,9 @@ namespace tribo
   /// The signal that asked to stop, or 0.
   int stop_requested();
 
+  /// @p s as one single-quoted POSIX shell word (for commands run with std::system).
+  std::string shell_quote(const std::string &s);
+
   /// "progress  42.0 %  t = 1.2e-06 s  3100 steps/s  ETA 12 s", rewritten in
   /// place on stderr at most a few times a second.
   class ProgressLine

@@ -16,7 +16,9 @@
 /// r~_n = r_n + gamma h >= 0 (so r_n >= -gamma h, Cao et al. 2011 eq. 7).
 /// - IQS (inelastic quasi-shock): 0 <= r~_n  _|_  u_n + max(0, g)/(theta h) >= 0:
 ///   a closing gap is closed exactly at the end of the step and an existing
-///   overlap is frozen (never pushed out). Cao et al. eq. (7).
+///   overlap is frozen (never pushed out). Cao et al. eq. (7). With an overlap
+///   recovery beta > 0 the shift for g < 0 is beta g/(theta h): a fraction beta
+///   of the overlap is pushed out per step.
 /// - ELAS (elastic): F~_n = max(0, -k g_end), i.e. r~_n = h k max(0, -(g + theta h u_n)),
 ///   solved in closed form as a Signorini problem with the shift g/(theta h)
 ///   and the augmented diagonal W_nn + 1/(theta k h^2). Cao et al. eq. (8)
@@ -42,6 +44,10 @@ namespace tribo::dem
     double cohesion_range  = 0; ///< d_w, m
     double stiffness       = 0; ///< k, N/m^2 (force per unit depth per metre of overlap), ELAS only
     double friction        = 0; ///< Coulomb coefficient mu, dimensionless
+    /// IQS only: fraction beta in [0, 1] of an existing overlap pushed out per step
+    /// (shift beta g/(theta h) for g < 0). 0 freezes overlaps (the paper's IQS);
+    /// beta > 0 stops NLGS errors from accumulating into overlaps.
+    double overlap_recovery = 0;
 
     /// The terms of one contact's local problem that depend on its gap.
     struct Terms
@@ -58,7 +64,7 @@ namespace tribo::dem
       t.cohesion_impulse = (cohesion > 0 && g <= cohesion_range) ? cohesion * h : 0;
       if (type == Type::iqs)
         {
-          t.shift      = (g > 0 ? g : 0) / (theta * h);
+          t.shift      = (g > 0 ? g : overlap_recovery * g) / (theta * h);
           t.compliance = 0;
         }
       else

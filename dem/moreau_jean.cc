@@ -84,7 +84,7 @@ namespace tribo::dem
       if (c.r.x() != 0 || c.r.y() != 0)
         state.apply_impulse(c, c.r);
 
-    report.solver = solver.solve(current, state, contact_law);
+    report.solver = solver.solve(current, state, contact_law, th * h);
 
     // Gap measures with the final velocities.
     previous_impulse.clear();

@@ -31,7 +31,7 @@ namespace tribo::dem
   {}
 
   NlgsReport NlgsSolver::solve(std::vector<Contact> &contacts, BodyState &state,
-                               const ContactLaw &law)
+                               const ContactLaw &law, double theta_h)
   {
     NlgsReport report;
     const std::size_t n = contacts.size();
@@ -51,7 +51,8 @@ namespace tribo::dem
           std::shuffle(order.begin(), order.end(), rng);
         const bool check = (sweep % prm.check_interval == 0) || sweep == prm.max_iterations;
         double     sum_wrwr = 0, sum_wrr = 0, sum_dvdv = 0, sum_dvdvrr = 0, sum_dvor = 0;
-        double     max_dvdv = 0, max_dvdvrr = 0;
+        double     max_dvdv = 0, max_dvdvrr = 0, max_violation = 0;
+        const bool iqs = law.type == ContactLaw::Type::iqs;
         unsigned int active = 0;
         for (const unsigned int a : order)
           {
@@ -67,6 +68,8 @@ namespace tribo::dem
             if (dr.x() != 0 || dr.y() != 0)
               state.apply_impulse(c, dr);
             const Eigen::Vector2d u_after = u_now + c.W * dr;
+            if (check && iqs)
+              max_violation = std::max(max_violation, -(u_after.x() + c.shift));
             if (check && (r_new.x() != 0 || r_new.y() != 0))
               {
                 ++active;
@@ -89,6 +92,8 @@ namespace tribo::dem
         report.iterations = sweep;
         if (!check)
           continue;
+        report.gap_violation = theta_h * std::max(0.0, max_violation);
+        const bool gaps_ok   = prm.gap_tolerance <= 0 || report.gap_violation <= prm.gap_tolerance;
         if (active == 0)
           {
             report.converged = true;
@@ -112,7 +117,7 @@ namespace tribo::dem
           }
         const double criterion = std::max({std::abs(mean_dvor), dv_norm, dvr_norm});
         report.residual        = criterion * tol;
-        if (criterion < 1)
+        if (criterion < 1 && gaps_ok)
           {
             report.converged = true;
             break;

@@ -31,7 +31,7 @@ def running_mean(v, n):
 
 
 def main(directory):
-    stats = np.genfromtxt(os.path.join(directory, "statistics.csv"), delimiter=",", names=True)
+    stats = np.atleast_1d(np.genfromtxt(os.path.join(directory, "statistics.csv"), delimiter=",", names=True))
     with open(os.path.join(directory, "summary.json")) as f:
         summary = json.load(f)
     results = summary.get("results", {})
@@ -65,7 +65,7 @@ def main(directory):
 
     path = os.path.join(directory, "profiles.csv")
     if os.path.exists(path) and os.path.getsize(path) > 0:
-        p = np.genfromtxt(path, delimiter=",", names=True)
+        p = np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True))
         if p.size > 1:
             fig, axes = plt.subplots(1, 4, figsize=(11, 3.8), sharey=True)
             y = p["y_over_h"]

@@ -120,12 +120,29 @@ class WrongTypes(BadInputTestCase):
     def test_unknown_selection(self):
         msg, where = self.run_bad_case(case({"Simulation/Scene": "sliding"}))
         self.assert_at_line(msg, where["Simulation/Scene"])
-        self.assert_parts(msg, "Scene", "sliding", "collision|compaction")
+        self.assert_parts(msg, "Scene", "sliding", "collision|shear")
+
+    def test_removed_scene(self):
+        """The compaction scene is gone (a compaction is a shear run with Shear start >= End time)."""
+        msg, where = self.run_bad_case(case({"Simulation/Scene": "compaction"}))
+        self.assert_at_line(msg, where["Simulation/Scene"])
+        self.assert_parts(msg, "Scene", "compaction", "collision|shear")
+
+    def test_removed_subsection(self):
+        sections = {"Simulation": {"Scene": "shear"}, "Compaction": {"Number of discs": "60"}}
+        msg, _ = self.run_bad_case(sections)
+        self.assert_at_line(msg, 5)  # line 5: "subsection Compaction"
+        self.assert_parts(msg, "case.prm", "Compaction", "no such subsection")
 
     def test_not_a_bool(self):
         msg, where = self.run_bad_case(case({"Collision/Stop when separated": "maybe"}))
         self.assert_at_line(msg, where["Collision/Stop when separated"])
         self.assert_parts(msg, "Stop when separated", "maybe", "Bool")
+
+    def test_plots_not_a_bool(self):
+        msg, where = self.run_bad_case(case({"Output/Plots": "yes please"}))
+        self.assert_at_line(msg, where["Output/Plots"])
+        self.assert_parts(msg, "Plots", "yes please", "Bool")
 
 
 class MeaninglessValues(BadInputTestCase):
@@ -157,10 +174,30 @@ class MeaninglessValues(BadInputTestCase):
         self.assert_parts(msg, "Theta", "1.2", "0.5...1")
 
     def test_empty_sample(self):
-        sections = {"Simulation": {"Scene": "compaction"}, "Compaction": {"Number of discs": "0"}}
+        sections = {"Simulation": {"Scene": "shear"}, "Shear cell": {"Number of discs": "0"}}
         msg, where = self.run_bad_case(sections)
-        self.assert_at_line(msg, where["Compaction/Number of discs"])
+        self.assert_at_line(msg, where["Shear cell/Number of discs"])
         self.assert_parts(msg, "Number of discs", "0", "Integer range 1...")
+
+    def shear_entry(self, entry, value, expected):
+        """A small shear case with 'Shear cell/ENTRY' = VALUE: the tribo form of the message."""
+        sections = {"Simulation": {"Scene": "shear"},
+                    "Shear cell": {"Number of discs": "60", "Length": "1.2e-5", "Wall discs": "0"}}
+        sections["Shear cell"][entry] = value
+        self.check_entry("Shear cell/" + entry, value, expected, sections)
+
+    def test_negative_shear_start(self):
+        self.shear_entry("Shear start", "-1e-7", "a time >= 0 in s")
+
+    def test_negative_ramp_time(self):
+        self.shear_entry("Pressure ramp time", "-1e-7", "a time >= 0 in s")
+
+    def test_zero_pressure(self):
+        self.shear_entry("Pressure", "0", "a positive pressure in Pa")
+
+    def test_too_many_wall_discs(self):
+        # d (1 - s) = 0.96e-6 m: at most 12 discs fit along 1.2e-5 m.
+        self.shear_entry("Wall discs", "13", "at most 12 discs")
 
     def test_negative_cohesion(self):
         self.check_entry("Contact law/Cohesion", "-1", "a cohesion >= 0 in N/m")
@@ -183,12 +220,23 @@ class MeaninglessValues(BadInputTestCase):
         self.check_entry("Collision/Impact velocity", "0", "a non-zero velocity in m/s")
 
     def test_period_too_short(self):
-        sections = {"Simulation": {"Scene": "compaction"},
-                    "Compaction": {"Number of discs": "10", "Length": "1e-6"}}
+        # 8 largest diameters: 8 x 1.2e-6 x 1.2 = 1.152e-5 m.
+        sections = {"Simulation": {"Scene": "shear"},
+                    "Shear cell": {"Number of discs": "10", "Length": "1.1e-5"}}
         msg, where = self.run_bad_case(sections)
-        self.assert_at_line(msg, where["Compaction/Length"])
-        self.assert_parts(msg, "entry 'Compaction/Length' = '1e-6'",
-                          "expected a length of at least 4 largest diameters")
+        self.assert_at_line(msg, where["Shear cell/Length"])
+        self.assert_parts(msg, "entry 'Shear cell/Length' = '1.1e-5'",
+                          "expected a length of at least 8 largest diameters (1.152e-05 m)")
+
+    def test_default_shear_case_is_valid(self):
+        """The limits above are the only ones hit: the same case with a long enough
+        period passes `tribo check`."""
+        write_prm(os.path.join(self.tmp, "case.prm"),
+                  {"Simulation": {"Scene": "shear"},
+                   "Shear cell": {"Number of discs": "10", "Length": "1.2e-5", "Wall discs": "12"}})
+        r = run(["check", "case.prm"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout.strip(), "case.prm: OK (scene shear)")
 
     def test_check_gives_the_same_message(self):
         write_prm(os.path.join(self.tmp, "case.prm"), case({"Collision/Density": "-1"}))

@@ -1,5 +1,6 @@
 """An interrupted run (SIGTERM, SIGINT) ends cleanly: exit 128+N, outputs that
-hold the steps done, summary.json status "interrupted", results.h5
+hold the steps done (the shear scene's profiles.csv and, with Output/Plots,
+its PNG plots included), summary.json status "interrupted", results.h5
 complete = 0, no NAME.tmp left behind.
 
 Usage: /usr/bin/python3 test_interrupt.py /path/to/tribo
@@ -10,21 +11,32 @@ import signal
 import subprocess
 import sys
 import time
-import unittest
 
 import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import tribo_cli  # noqa: E402
-from tribo_cli import TempDirTestCase, read_csv, read_json, read_pvd, tmp_files, write_prm  # noqa: E402
+from tribo_cli import (PLOTS, PROFILE_COLUMNS, TempDirTestCase, read_csv, read_json,  # noqa: E402
+                       read_png, read_pvd, tmp_files, write_prm)
 
-#: A compaction far too long to finish during the test (5e5 steps).
+#: A shear run far too long to finish during the test (5e5 steps): 60 discs,
+#: sliding from step 100 on, a profile sample every 5 steps.
 LONG = {
-    "Simulation": {"Scene": "compaction", "Time step": "2e-9", "End time": "1e-3"},
-    "Compaction": {"Number of discs": "60", "Length": "1.2e-5", "Pressure ramp steps": "50"},
-    "Output": {"Statistics interval": "1", "Field interval": "0"},
+    "Simulation": {"Scene": "shear", "Time step": "2e-9", "End time": "1e-3"},
+    "Shear cell": {"Number of discs": "60", "Length": "1.2e-5", "Wall discs": "0",
+                   "Pressure ramp time": "1e-7", "Shear start": "2e-7", "Profile samples": "100000"},
+    "Output": {"Statistics interval": "1", "Field interval": "0", "Plots": "false"},
 }
+
+
+def with_changes(changes):
+    """LONG with {"Subsection/Entry": value} changes."""
+    sections = {k: dict(v) for k, v in LONG.items()}
+    for path, value in changes.items():
+        section, entry = path.split("/")
+        sections[section][entry] = value
+    return sections
 
 
 class Interrupt(TempDirTestCase):
@@ -90,6 +102,19 @@ class Interrupt(TempDirTestCase):
         self.assertEqual(len(records), s["n_field_snapshots"])
         self.assertAlmostEqual(records[-1][0], s["simulated_time"], delta=1e-9 * s["simulated_time"])
         self.assertEqual(tmp_files(self.out), [], "no NAME.tmp may be left behind")
+
+        # The shear results and profiles of the steps done (sliding from step 100 on).
+        r = s["results"]
+        self.assertIs(r["sliding"], True)
+        self.assertEqual(r["averaging_start"], r["steady_state_start"])
+        header, p = read_csv(os.path.join(self.out, "profiles.csv"))
+        self.assertEqual(header, PROFILE_COLUMNS)
+        self.assertGreater(r["profile_samples_in_steady_state"], 0)
+        np.testing.assert_array_equal(p["n_samples"], r["profile_samples_in_steady_state"])
+        with h5py.File(os.path.join(self.out, "results.h5"), "r") as f:
+            self.assertEqual(f["profiles"].attrs["n_rows"], len(p["layer"]))
+            for name in header:
+                np.testing.assert_array_equal(f["profiles"][name][()], p[name], err_msg=name)
         return s, st
 
     def test_sigterm(self):
@@ -98,17 +123,20 @@ class Interrupt(TempDirTestCase):
         self.check_interrupted(signal.SIGTERM)
 
     def test_sigint(self):
-        self.start(LONG)
+        """Interrupted with Output/Plots = true: the plots of the steps done are made."""
+        self.start(with_changes({"Output/Plots": "true"}))
         self.wait_until_stepping()
         self.check_interrupted(signal.SIGINT)
+        for name in PLOTS:
+            image = read_png(self, os.path.join(self.out, name))
+            self.assertGreater(min(image.shape[:2]), 100, name)
+        with open(os.path.join(self.out, "log.txt")) as f:
+            self.assertNotIn("warning: the plots could not be made", f.read())
 
     def test_sigterm_sparse_statistics(self):
         """Rows only every 10^6 steps: the interrupted run must still end with the row
         of its last step (the run does about 10^4 steps before the signal)."""
-        sections = {k: dict(v) for k, v in LONG.items()}
-        sections["Simulation"]["End time"] = "1e-2"
-        sections["Output"]["Statistics interval"] = "1000000"
-        self.start(sections)
+        self.start(with_changes({"Simulation/End time": "1e-2", "Output/Statistics interval": "1000000"}))
         self.wait_until_stepping()
         code, stderr = self.interrupt(signal.SIGTERM)
         self.assertEqual(code, 128 + signal.SIGTERM, stderr)

@@ -1,6 +1,10 @@
 """The output directory of `tribo run` (docs/outputs.md), checked by value:
 statistics.csv, results.h5, summary.json, the VTU snapshots and their .pvd
-indices, for a small ELAS collision and a small compaction; a failing run.
+indices, profiles.csv and the PNG plots, for a small ELAS collision, a small
+compaction-only shear run and a small sliding shear run; a failing run.
+
+The physics of steady shear (equilibrium, power balance) is not asserted
+here: only what each output means, as docs/outputs.md defines it.
 
 Usage: /usr/bin/python3 test_outputs.py /path/to/tribo
 """
@@ -17,9 +21,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import tribo_cli  # noqa: E402
-from tribo_cli import (COMMON_COLUMNS, SCENE_COLUMNS, TempDirTestCase, decode_vtu,  # noqa: E402
-                       read_csv, read_json, read_pvd, read_vtu_with_vtk, run, tmp_files,
-                       write_prm)
+from tribo_cli import (COMMON_COLUMNS, PLOTS, PROFILE_COLUMNS, SCENE_COLUMNS,  # noqa: E402
+                       TempDirTestCase, decode_vtu, read_csv, read_json, read_png, read_pvd,
+                       read_vtu_with_vtk, run, tmp_files, write_prm)
 
 FILES = ["fields", "log.txt", "original.prm", "parameters.prm", "results.h5",
          "statistics.csv", "summary.json"]
@@ -33,6 +37,8 @@ class RunOnce:
     directory, and check what every scene shares."""
 
     SECTIONS = None
+    #: Files of the output directory besides FILES.
+    EXTRA_FILES = []
 
     @classmethod
     def setUpClass(cls):
@@ -55,7 +61,7 @@ class RunOnce:
     def test_exit_and_files(self):
         self.assertEqual(self.result.returncode, 0, self.result.stderr)
         self.assertEqual(self.result.stdout, "", "--quiet prints nothing")
-        self.assertEqual(sorted(os.listdir(self.out)), FILES)
+        self.assertEqual(sorted(os.listdir(self.out)), sorted(FILES + self.EXTRA_FILES))
         self.assertEqual(tmp_files(self.out), [], "no NAME.tmp may be left behind")
 
     def test_statistics_header(self):
@@ -86,14 +92,30 @@ class RunOnce:
         self.assertGreater(s["wall_time"], 0)
         self.assertEqual(s["n_field_snapshots"], len(read_pvd(os.path.join(self.fields, "discs.pvd"))))
 
+    def imposed_kinetic_energy(self):
+        """Kinetic energy of the bodies whose imposed velocity changes during the run
+        (none by default), per row: it changes without power."""
+        return 0.0
+
+    def kinetic_energy_removed(self):
+        """Kinetic energy taken out between steps (a velocity cap), summed up to each row."""
+        return 0.0
+
     def test_energy_balance(self):
         """Sum of h (power_contacts + power_external) is the change of kinetic energy
-        (exact for the Moreau-Jean update, rows at every step)."""
+        (exact for the Moreau-Jean update, rows at every step), bodies whose imposed
+        velocity jumps left out."""
         st, h = self.stats, self.summary["time_step"]
         ke0 = self.initial_kinetic_energy()
+        ke = st["kinetic_energy"] - self.imposed_kinetic_energy() + self.kinetic_energy_removed()
         work = np.cumsum(h * (st["power_contacts"] + st["power_external"]))
-        scale = max(np.abs(st["kinetic_energy"]).max(), ke0)
-        np.testing.assert_allclose(work, st["kinetic_energy"] - ke0, rtol=0, atol=1e-9 * scale)
+        scale = max(np.abs(ke).max(), ke0)
+        np.testing.assert_allclose(work, ke - ke0, rtol=0, atol=1e-9 * scale)
+
+    def tables(self):
+        """The scene's extra tables: {NAME: (header, columns)} of every NAME.csv."""
+        return {f[:-4]: read_csv(os.path.join(self.out, f)) for f in os.listdir(self.out)
+                if f.endswith(".csv") and f != "statistics.csv"}
 
     def test_results_h5(self):
         with h5py.File(os.path.join(self.out, "results.h5"), "r") as f:
@@ -102,6 +124,17 @@ class RunOnce:
             self.assertEqual(f.attrs["time_step"], self.summary["time_step"])
             self.assertEqual(f.attrs["simulated_time"], self.summary["simulated_time"])
             self.assertEqual(f.attrs["wall_time"], self.summary["wall_time"])
+            tables = self.tables()
+            self.assertEqual(sorted(f.keys()), sorted(["statistics", "parameters"] + list(tables)))
+            for name, (header, columns) in tables.items():
+                g = f[name]
+                n_rows = len(columns[header[0]])
+                self.assertEqual(g.attrs["n_rows"], n_rows, name)
+                # No dataset for a table without rows (as for /statistics).
+                self.assertEqual(sorted(g.keys()), sorted(header) if n_rows else [], name)
+                for column in (header if n_rows else []):
+                    np.testing.assert_array_equal(g[column][()], columns[column],
+                                                  err_msg="%s/%s" % (name, column))
             g = f["statistics"]
             self.assertEqual(sorted(g.keys()), sorted(self.header))
             self.assertEqual(g.attrs["n_rows"], len(self.stats["step"]))
@@ -146,6 +179,7 @@ class RunOnce:
         self.assertEqual(lines[0], "tribo run case.prm -> out")
         self.assertTrue(lines[1].startswith("scene %s: " % self.summary["scene"]), lines[1])
         self.assertTrue(lines[-1].startswith("status complete: %d steps" % self.summary["steps"]), lines[-1])
+        self.assertFalse([l for l in lines if l.startswith("warning")], "no warnings")
 
     def test_pvd_indices(self):
         times_expected = self.snapshot_times()
@@ -195,14 +229,19 @@ class RunOnce:
         self.assertEqual(v["n_cells"], int(self.stats["n_active_contacts"][-1]))
 
     def test_docs_cover_outputs(self):
-        """docs/outputs.md names every column, summary key and VTU array (in backquotes)."""
+        """docs/outputs.md names every file, column, summary key, table column, HDF5
+        group and VTU array (in backquotes)."""
         with open(tribo_cli.OUTPUTS_MD) as f:
             doc = f.read()
         names = list(self.header) + list(self.summary) + list(self.summary["results"])
         names += ["radius", "velocity", "spin", "body", "normal_force", "tangential_force", "gap",
-                  "complete", "n_rows"]
+                  "complete", "n_rows", "statistics", "parameters"]
+        for name, (header, _) in self.tables().items():
+            names += [name] + header
+        names += [f for f in os.listdir(self.out) if f != "fields"]
         missing = [n for n in names if "`%s`" % n not in doc]
         self.assertEqual(missing, [], "undocumented in docs/outputs.md")
+        self.assertIn("`fields/", doc)
 
 
 class Collision(RunOnce, unittest.TestCase):
@@ -294,125 +333,455 @@ class Collision(RunOnce, unittest.TestCase):
         self.assertAlmostEqual(gap / self.stats["gap"][-1], 1, delta=1e-3)  # float32 positions
 
 
-class Compaction(RunOnce, unittest.TestCase):
-    """60 discs pressed between rough walls, IQS without cohesion."""
+# ---------------------------------------------------------------------------
+# The shear scene.
 
-    N, D, S, L, RHO, P, THICK, RAMP = 60, 1.2e-6, 0.2, 1.2e-5, 7800.0, 1e8, 1.5e-4, 50
-    SECTIONS = {
-        "Simulation": {"Scene": "compaction", "Time step": "2e-9", "End time": "4e-7"},
+#: summary.json "results" keys of a shear run, in this order (docs/outputs.md).
+COMPACTION_RESULTS = ["sliding", "averaging_start", "normal_force_mean", "normal_force_target",
+                      "third_body_thickness", "solid_fraction_mean", "cohesion_number"]
+SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "averaging_start",
+                   "normal_force_mean", "normal_force_target", "third_body_thickness",
+                   "solid_fraction_mean", "cohesion_number", "mu_mean", "mu_std",
+                   "power_lower_wall_mean", "power_upper_wall_mean", "power_dissipated_mean",
+                   "power_third_body_mean", "power_balance_ratio", "inertial_number",
+                   "profile_samples_in_steady_state", "sigma_xx_mean", "sigma_yy_mean",
+                   "sigma_xy_mean"]
+
+
+def shear_sections(n, end_time, shear_start, ramp_time, plots, **extra):
+    """A small shear case: N discs, L = 1.2e-5 m, walls of L/d discs, h = 2e-9 s.
+    @p extra: {"Subsection": {entry: value}} merged in."""
+    sections = {
+        "Simulation": {"Scene": "shear", "Time step": "2e-9", "End time": end_time},
         "Contact law": {"Law": "IQS"},
-        "Compaction": {"Number of discs": "60", "Mean diameter": "1.2e-6", "Diameter spread": "0.2",
-                       "Length": "1.2e-5", "Pressure": "1e8", "Pressure ramp steps": "50",
+        "Shear cell": {"Number of discs": n, "Mean diameter": "1.2e-6", "Diameter spread": "0.2",
+                       "Length": "1.2e-5", "Wall discs": "0", "Pressure": "1e8",
+                       "Pressure ramp time": ramp_time, "Shear start": shear_start,
                        "Upper body thickness": "1.5e-4", "Density": "7800"},
-        "Output": {"Field interval": "50", "Statistics interval": "1"},
+        "Output": {"Statistics interval": "1", "Plots": plots},
     }
+    for section, entries in extra.items():
+        sections.setdefault(section, {}).update(entries)
+    return sections
+
+
+def steady_state(time, series, absolute, t0, t1, tolerance=0.1):
+    """The steady-state rule of docs/outputs.md (app/steady_state.h), from the rows."""
+    for k in range(1, 6):
+        s = t0 + k * (t1 - t0) / 10
+        mid = 0.5 * (s + t1)
+        ok = True
+        for v, a_min in zip(series, absolute):
+            first = (time >= s) & (time < mid)
+            second = (time >= mid) & (time < t1 + 1e-30 + 1e-12 * abs(t1))
+            if not first.any() or not second.any():
+                ok = False
+                break
+            a, b = v[first].mean(), v[second].mean()
+            if not abs(a - b) <= max(tolerance * max(abs(a), abs(b)), a_min):
+                ok = False
+                break
+        if ok:
+            return True, s
+    return False, 0.5 * (t0 + t1)
+
+
+class ShearRun(RunOnce):
+    """Checks shared by the compaction-only and the sliding shear runs (60 or 100
+    discs, IQS without cohesion, walls of L/d = 10 discs, rows at every step)."""
+
+    D, S, L, RHO, P, THICK, H = 1.2e-6, 0.2, 1.2e-5, 7800.0, 1e8, 1.5e-4, 2e-9
+    N = RAMP_TIME = SHEAR_START = END_TIME = FIELD_INTERVAL = None
 
     def initial_kinetic_energy(self):
         return 0.0
 
     def snapshot_times(self):
-        return [k * 50 * 2e-9 for k in range(5)]
+        steps = int(round(self.END_TIME / self.H))
+        return [k * self.FIELD_INTERVAL * self.H for k in range(steps // self.FIELD_INTERVAL + 1)]
+
+    @classmethod
+    def discs(cls):
+        """The first snapshot: {"lower", "upper", "grains"} radius arrays (float64 of the
+        stored float32) and the snapshot itself."""
+        if not hasattr(cls, "_discs"):
+            pvd = read_pvd(os.path.join(cls.fields, "discs.pvd"))
+            first = decode_vtu(os.path.join(cls.fields, pvd[0][1]))
+            body = first["point_data"]["body"].ravel()
+            r = first["point_data"]["radius"].ravel().astype(float)
+            upper = cls.summary["n_bodies"] - 1
+            cls._discs = {"lower": r[body == 0], "upper": r[body == upper],
+                          "grains": r[(body != 0) & (body != upper)], "snapshot": first}
+        return cls._discs
+
+    @classmethod
+    def parameters(cls):
+        """Every parameter as used, {"Subsection/Entry": text}, from results.h5."""
+        if not hasattr(cls, "_parameters"):
+            with h5py.File(os.path.join(cls.out, "results.h5"), "r") as f:
+                cls._parameters = {k: str(v) for k, v in f["parameters"].attrs.items()}
+        return cls._parameters
+
+    def upper_wall_vy_begin(self):
+        """The upper wall's y velocity at the start of each step (rows at every step):
+        the previous row's, capped at Shear cell/Compaction speed limit (if > 0) for
+        the steps starting before Shear start."""
+        st, h = self.stats, self.summary["time_step"]
+        v = np.concatenate([[0.0], st["upper_wall_vy"][:-1]])
+        limit = float(self.parameters().get("Shear cell/Compaction speed limit", "0"))
+        if limit > 0:
+            compacting = (st["step"] - 1) * h < self.SHEAR_START
+            v[compacting] = np.clip(v[compacting], -limit, limit)
+        return v
+
+    def kinetic_energy_removed(self):
+        """The speed cap takes m (v_before^2 - v_capped^2)/2 from the upper wall."""
+        st = self.stats
+        v_before = np.concatenate([[0.0], st["upper_wall_vy"][:-1]])
+        m = self.RHO * self.THICK * self.L
+        return np.cumsum(0.5 * m * (v_before ** 2 - self.upper_wall_vy_begin() ** 2))
+
+    def mean_wall_diameter(self):
+        d = self.discs()
+        return np.concatenate([2 * d["lower"], 2 * d["upper"]]).mean()
+
+    def sliding_rows(self):
+        """Rows of the steps during which the lower wall slides: the step starting at
+        t = (step - 1) h >= Shear start."""
+        return (self.stats["step"] - 1) * self.summary["time_step"] >= self.SHEAR_START
 
     def test_steps_and_parameters(self):
         s = self.summary
-        self.assertEqual(s["steps"], 200)
-        self.assertEqual(s["steps_planned"], 200)
-        self.assertEqual(s["time_step"], 2e-9)
+        steps = int(round(self.END_TIME / self.H))
+        self.assertEqual(s["steps"], steps)
+        self.assertEqual(s["steps_planned"], steps)
+        self.assertEqual(s["time_step"], self.H)
         with h5py.File(os.path.join(self.out, "results.h5"), "r") as f:
-            self.assertEqual(float(f["parameters"].attrs["Simulation/Time step"]), 2e-9)
-            self.assertEqual(f.attrs["time_step"], 2e-9)
-            self.assertEqual(int(f["parameters"].attrs["Compaction/Number of discs"]), 60)
+            self.assertEqual(float(f["parameters"].attrs["Simulation/Time step"]), self.H)
+            self.assertEqual(f.attrs["time_step"], self.H)
+            self.assertEqual(int(f["parameters"].attrs["Shear cell/Number of discs"]), self.N)
+            self.assertEqual(f["parameters"].attrs["Output/Plots"], self.SECTIONS["Output"]["Plots"])
 
-    def free_disc_mask(self, v):
-        body = v["point_data"]["body"].ravel()
-        return (body != 0) & (body != self.summary["n_bodies"] - 1)
+    def test_results_keys(self):
+        r = self.summary["results"]
+        self.assertEqual(list(r), SLIDING_RESULTS if self.sliding else COMPACTION_RESULTS)
+        self.assertIs(r["sliding"], self.sliding)
 
     def test_disc_values(self):
-        pvd = read_pvd(os.path.join(self.fields, "discs.pvd"))
-        first = read_vtu_with_vtk(self, os.path.join(self.fields, pvd[0][1]))
+        d = self.discs()
+        first = read_vtu_with_vtk(self, os.path.join(self.fields, read_pvd(os.path.join(self.fields, "discs.pvd"))[0][1]))
         self.assertEqual(first["n_points"], self.summary["n_discs"])
-        free = self.free_disc_mask(first)
-        self.assertEqual(int(free.sum()), self.N)
-        self.assertEqual(self.summary["results"]["n_free_discs"], self.N)
+        # Wall discs 0: round(L/d) = 10 discs per wall.
+        self.assertEqual(len(d["lower"]), 10)
+        self.assertEqual(len(d["upper"]), 10)
+        self.assertEqual(len(d["grains"]), self.N)
         self.assertEqual(self.summary["n_bodies"], self.N + 2)
+        self.assertEqual(self.summary["n_discs"], self.N + 20)
         r = first["point_data"]["radius"].ravel()
         lo, hi = self.D * (1 - self.S) / 2, self.D * (1 + self.S) / 2
-        self.assertTrue(np.all(r[free] >= lo * (1 - F32)) and np.all(r[free] <= hi * (1 + F32)), (r.min(), r.max()))
+        self.assertTrue(np.all(r >= lo * (1 - F32)) and np.all(r <= hi * (1 + F32)), (r.min(), r.max()))
         np.testing.assert_array_equal(first["point_data"]["velocity"], 0, "at rest at t = 0")
         x = first["points"][:, 0]
         self.assertTrue(np.all((x >= 0) & (x <= self.L * (1 + F32))), "x wrapped into [0, L)")
+        body = first["point_data"]["body"].ravel()
+        np.testing.assert_array_equal(first["points"][body == 0, 1], 0, "lower wall centre line at y = 0")
         self.assertAlmostEqual(self.summary["max_overlap_over_min_radius"],
                                self.summary["max_overlap"] / r.min(), delta=1e-6 * self.summary["max_overlap_over_min_radius"])
 
         # The last snapshot holds the state after the last step.
+        pvd = read_pvd(os.path.join(self.fields, "discs.pvd"))
         last = read_vtu_with_vtk(self, os.path.join(self.fields, pvd[-1][1]))
         body = last["point_data"]["body"].ravel()
         upper = body == self.summary["n_bodies"] - 1
         np.testing.assert_allclose(last["points"][upper, 1], self.stats["upper_wall_y"][-1], rtol=1e-6)
         np.testing.assert_allclose(last["point_data"]["velocity"][upper, 1], self.stats["upper_wall_vy"][-1], rtol=1e-6)
-        np.testing.assert_array_equal(last["point_data"]["velocity"][body == 0], 0, "lower wall fixed")
-        # Kinetic energy of the last row from the snapshot: grains (discs) plus the upper wall.
-        free = self.free_disc_mask(last)
+        np.testing.assert_array_equal(last["point_data"]["velocity"][upper, 0], 0, "upper wall: no x motion")
+        np.testing.assert_array_equal(last["point_data"]["spin"][upper], 0, "upper wall: no rotation")
+        v_lower = self.SECTIONS["Shear cell"].get("Sliding velocity", "5") if self.sliding else 0
+        np.testing.assert_allclose(last["point_data"]["velocity"][body == 0],
+                                   [[float(v_lower), 0, 0]] * 10, rtol=F32, atol=0)
+        np.testing.assert_allclose(last["points"][body == 0, 1], 0, atol=1e-20)
+        # The kinetic energy of the grains from the snapshot.
+        free = (body != 0) & ~upper
         rr = last["point_data"]["radius"].ravel()[free].astype(float)
         v = last["point_data"]["velocity"][free].astype(float)
         w = last["point_data"]["spin"].ravel()[free].astype(float)
         m = self.RHO * math.pi * rr ** 2
         ke = np.sum(0.5 * m * (v ** 2).sum(axis=1) + 0.5 * (0.5 * m * rr ** 2) * w ** 2)
-        m_upper = self.RHO * self.THICK * self.L
-        ke += 0.5 * m_upper * self.stats["upper_wall_vy"][-1] ** 2
-        self.assertAlmostEqual(ke / self.stats["kinetic_energy"][-1], 1, delta=1e-5)
-        # power_free covers the grains only: its work is their kinetic energy.
-        grains = self.stats["kinetic_energy"][-1] - 0.5 * m_upper * self.stats["upper_wall_vy"][-1] ** 2
-        work = np.sum(self.summary["time_step"] * self.stats["power_free"])
-        self.assertAlmostEqual(work / grains, 1, delta=1e-9)
+        self.assertAlmostEqual(ke / self.stats["kinetic_energy_third_body"][-1], 1, delta=1e-5)
 
-    def test_compaction_columns(self):
-        st = self.stats
-        target = self.P * self.L
-        ramp = np.minimum(1.0, st["step"] / self.RAMP) * target
-        np.testing.assert_allclose(st["applied_force"], ramp, rtol=1e-12)
-        self.assertTrue(np.all(st["lower_wall_normal_force"] >= 0), "grains push the lower wall down")
-        self.assertGreater(st["lower_wall_normal_force"].max(), 0)
-        self.assertTrue(np.all((st["solid_fraction"] > 0) & (st["solid_fraction"] < 1)))
+    def test_shear_columns(self):
+        """Every column by its definition, in every row."""
+        st, h = self.stats, self.summary["time_step"]
+        # The applied force: P L ramped linearly over the ramp time.
+        ramp = np.minimum(1.0, st["time"] / self.RAMP_TIME) * self.P * self.L
+        np.testing.assert_allclose(st["normal_force"], ramp, rtol=1e-12)
+        self.assertTrue(np.all(st["lower_wall_normal_force"] >= 0), "no cohesion: the grains push the lower wall down")
         self.assertLess(st["upper_wall_vy"][0], 0, "the upper wall starts moving down")
         self.assertLess(st["upper_wall_y"][-1], st["upper_wall_y"][0])
-        # External power: the fixed lower wall does no work; the rest is the load on the upper wall.
-        np.testing.assert_array_equal(st["power_lower_wall"], 0)
+        # The gap between the wall centre lines (the lower one at y = 0).
+        np.testing.assert_array_equal(st["gap"], st["upper_wall_y"])
+        # The solid fraction: grain area over (gap - mean wall diameter) L.
+        area = np.sum(math.pi * self.discs()["grains"] ** 2)
+        np.testing.assert_allclose(st["solid_fraction"] * (st["gap"] - self.mean_wall_diameter()) * self.L,
+                                   area, rtol=2e-6)
+        # Kinetic energies: the upper wall moves in y only (its mass: density x thickness x L).
+        np.testing.assert_allclose(st["kinetic_energy_upper_wall"],
+                                   0.5 * self.RHO * self.THICK * self.L * st["upper_wall_vy"] ** 2, rtol=1e-12)
+        self.assertTrue(np.all(st["kinetic_energy_third_body"] >= 0))
+        # The grains are the free bodies: the work of power_free is their kinetic energy.
+        np.testing.assert_allclose(np.cumsum(h * st["power_free"]), st["kinetic_energy_third_body"],
+                                   rtol=0, atol=1e-9 * st["kinetic_energy_third_body"].max())
+        # Powers: the walls are the only driven bodies; the dissipation is minus the contact power.
         np.testing.assert_allclose(st["power_lower_wall"] + st["power_upper_wall"], st["power_external"],
-                                   rtol=1e-12, atol=0)
-        # The load (downwards) times the mean velocity over the step (rows at every step, at rest at t = 0).
-        vy_begin = np.concatenate([[0.0], st["upper_wall_vy"][:-1]])
-        v_mid = 0.5 * (vy_begin + st["upper_wall_vy"])
-        np.testing.assert_allclose(st["power_upper_wall"], -st["applied_force"] * v_mid,
+                                   rtol=1e-12, atol=1e-14 * np.abs(st["power_external"]).max())
+        np.testing.assert_array_equal(st["power_dissipated"], -st["power_contacts"])
+        # The upper wall: the downward load times the mean y velocity over the step.
+        v_mid = 0.5 * (self.upper_wall_vy_begin() + st["upper_wall_vy"])
+        np.testing.assert_allclose(st["power_upper_wall"], -st["normal_force"] * v_mid,
                                    rtol=1e-9, atol=1e-12 * np.abs(st["power_upper_wall"]).max())
+        # The lower wall does no work while it is fixed.
+        sliding = self.sliding_rows()
+        np.testing.assert_array_equal(st["power_lower_wall"][~sliding], 0)
+        np.testing.assert_array_equal(st["kinetic_energy"][~sliding],
+                                      st["kinetic_energy_third_body"][~sliding] + st["kinetic_energy_upper_wall"][~sliding])
+        self.assertTrue(np.all(np.isfinite(st["mu"])))
 
-        # Scene results recomputed from the statistics (last fifth of the rows).
-        r = self.summary["results"]
-        n = len(st["step"])
-        tail = slice(n - max(1, n // 5), n)
-        self.assertEqual(r["target_normal_force"], target)
-        self.assertAlmostEqual(r["mean_lower_wall_normal_force"] / st["lower_wall_normal_force"][tail].mean(), 1, places=12)
-        self.assertAlmostEqual(r["normal_force_ratio"] * st["applied_force"][tail].sum()
-                               / st["lower_wall_normal_force"][tail].sum(), 1, places=12)
-        self.assertAlmostEqual(r["mean_solid_fraction"], st["solid_fraction"][tail].mean(), places=12)
-        self.assertEqual(r["upper_wall_y"], st["upper_wall_y"][-1])
+    def test_common_results(self):
+        """The results of every shear run, recomputed from the statistics."""
+        r, st = self.summary["results"], self.stats
+        window = st["time"] >= r["averaging_start"]
+        self.assertTrue(window.any())
+        self.assertEqual(r["normal_force_target"], self.P * self.L)
+        np.testing.assert_allclose(r["normal_force_mean"], st["lower_wall_normal_force"][window].mean(), rtol=1e-12)
+        np.testing.assert_allclose(r["solid_fraction_mean"], st["solid_fraction"][window].mean(), rtol=1e-12)
+        np.testing.assert_allclose(r["third_body_thickness"], st["gap"][window].mean() - self.mean_wall_diameter(),
+                                   rtol=1e-6)
+        self.assertEqual(r["cohesion_number"], 0, "no cohesion")
 
-        # The solid fraction: grain area over the area between the wall centre lines.
-        pvd = read_pvd(os.path.join(self.fields, "discs.pvd"))
-        last = read_vtu_with_vtk(self, os.path.join(self.fields, pvd[-1][1]))
-        rr = last["point_data"]["radius"].ravel()[self.free_disc_mask(last)].astype(float)
-        body = last["point_data"]["body"].ravel()
-        y_lower = last["points"][body == 0, 1].astype(float).mean()
-        phi = np.sum(math.pi * rr ** 2) / ((st["upper_wall_y"][-1] - y_lower) * self.L)
-        self.assertAlmostEqual(phi / st["solid_fraction"][-1], 1, delta=1e-5)
+
+class Compaction(ShearRun, unittest.TestCase):
+    """A compaction-only shear run: 60 discs pressed for 200 steps, Shear start > End time."""
+
+    N, RAMP_TIME, SHEAR_START, END_TIME, FIELD_INTERVAL = 60, 1e-7, 1e-6, 4e-7, 50
+    sliding = False
+    EXTRA_FILES = ["profiles.csv"]
+    SECTIONS = shear_sections("60", "4e-7", "1e-6", "1e-7", "false",
+                              Output={"Field interval": "50"})
+
+    def test_compaction_results(self):
+        r, st = self.summary["results"], self.stats
+        # Averaging over the last fifth of the time covered by the rows.
+        t0, t1 = st["time"][0], st["time"][-1]
+        self.assertEqual(r["averaging_start"], t0 + 0.8 * (t1 - t0))
+        np.testing.assert_array_equal(st["power_lower_wall"], 0)
+
+    def test_no_profiles(self):
+        """No shearing, no profile sample: profiles.csv has its header only, the HDF5
+        group "profiles" no datasets; no plots (Plots = false)."""
+        header, columns = read_csv(os.path.join(self.out, "profiles.csv"))
+        self.assertEqual(header, PROFILE_COLUMNS)
+        self.assertEqual(len(columns["layer"]), 0)
+        with h5py.File(os.path.join(self.out, "results.h5"), "r") as f:
+            self.assertEqual(f["profiles"].attrs["n_rows"], 0)
+            self.assertEqual(list(f["profiles"].keys()), [])
+
+
+class Sliding(ShearRun, unittest.TestCase):
+    """A sliding shear run: 100 discs compacted for 200 steps, then sheared at V = 5 m/s
+    for 800 steps with 50 profile samples; plots on."""
+
+    N, RAMP_TIME, SHEAR_START, END_TIME, FIELD_INTERVAL = 100, 2e-7, 4e-7, 2e-6, 500
+    V, SAMPLES = 5.0, 50
+    sliding = True
+    EXTRA_FILES = ["profiles.csv"] + PLOTS
+    SECTIONS = shear_sections("100", "2e-6", "4e-7", "2e-7", "true",
+                              **{"Shear cell": {"Sliding velocity": "5", "Profile samples": "50"},
+                                 "Output": {"Field interval": "500"}})
+
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        cls.profile_header, cls.profiles = read_csv(os.path.join(cls.out, "profiles.csv"))
+
+    def imposed_kinetic_energy(self):
+        """The lower wall's, which jumps to m V^2/2 at Shear start."""
+        st = self.stats
+        return st["kinetic_energy"] - st["kinetic_energy_third_body"] - st["kinetic_energy_upper_wall"]
+
+    def sample_times(self):
+        """The times of the profile samples: the first step ending at or after
+        Shear start + (k + 1/2) (End time - Shear start) / Profile samples."""
+        interval = (self.END_TIME - self.SHEAR_START) / self.SAMPLES
+        times = []
+        for t in self.stats["time"]:  # a row at every step
+            if len(times) < self.SAMPLES and t >= self.SHEAR_START + (len(times) + 0.5) * interval - 0.5 * self.H:
+                times.append(t)
+        return np.array(times)
+
+    def test_lower_wall(self):
+        sliding = self.sliding_rows()
+        self.assertEqual(int(sliding.sum()), 800)
+        m_lower = self.RHO * math.pi * np.sum(self.discs()["lower"] ** 2)
+        ke_lower = self.imposed_kinetic_energy()
+        np.testing.assert_allclose(ke_lower[sliding], 0.5 * m_lower * self.V ** 2, rtol=1e-6)
+        np.testing.assert_allclose(ke_lower[~sliding], 0, atol=1e-12 * ke_lower.max())
+
+    def test_mu(self):
+        """mu = -F_x / normal_force, F_x the x contact force on the lower wall, whose
+        power is -F_x V: power_lower_wall = mu normal_force V (to round-off)."""
+        st = self.stats
+        sliding = self.sliding_rows()
+        expected = st["mu"] * st["normal_force"] * self.V
+        np.testing.assert_allclose(st["power_lower_wall"][sliding], expected[sliding], rtol=1e-12,
+                                   atol=1e-12 * np.abs(expected).max())
+        self.assertGreater(np.abs(st["power_lower_wall"][sliding]).max(), 0)
+
+    def test_steady_state_and_means(self):
+        r, st = self.summary["results"], self.stats
+        t1 = st["time"][-1]
+        reached, start = steady_state(st["time"], [st["mu"], st["kinetic_energy"]], [0.01, 0.0],
+                                      self.SHEAR_START, t1)
+        self.assertIs(r["steady_state_reached"], reached)
+        self.assertEqual(r["steady_state_start"], start)
+        self.assertEqual(r["averaging_start"], r["steady_state_start"])
+        w = st["time"] >= r["averaging_start"]
+        for key, column in (("mu_mean", "mu"), ("power_lower_wall_mean", "power_lower_wall"),
+                            ("power_upper_wall_mean", "power_upper_wall"),
+                            ("power_dissipated_mean", "power_dissipated"),
+                            ("power_third_body_mean", "power_free")):
+            np.testing.assert_allclose(r[key], st[column][w].mean(), rtol=1e-12, err_msg=key)
+        np.testing.assert_allclose(r["mu_std"], st["mu"][w].std(), rtol=1e-9)
+        np.testing.assert_allclose(r["power_balance_ratio"], r["power_dissipated_mean"] / r["power_lower_wall_mean"],
+                                   rtol=1e-12)
+        d_grains = 2 * self.discs()["grains"].mean()
+        np.testing.assert_allclose(r["inertial_number"],
+                                   self.V / r["third_body_thickness"] * d_grains * math.sqrt(self.RHO / self.P),
+                                   rtol=1e-6)
+
+    def test_profiles_table(self):
+        """profiles.csv: the documented columns; the samples, layers and stresses by definition."""
+        self.assertEqual(self.profile_header, PROFILE_COLUMNS)
+        p, r = self.profiles, self.summary["results"]
+        n = len(p["layer"])
+        np.testing.assert_array_equal(p["layer"], np.arange(n))
+        # The samples averaged: those at or after the start of the steady state.
+        times = self.sample_times()
+        self.assertEqual(len(times), self.SAMPLES)
+        steady = times >= r["steady_state_start"]
+        self.assertEqual(r["profile_samples_in_steady_state"], int(steady.sum()))
+        self.assertGreater(steady.sum(), 0)
+        np.testing.assert_array_equal(p["n_samples"], steady.sum())
+        # Layers: fixed at the first sample, about one mean diameter each.
+        mwd = self.mean_wall_diameter()
+        gap_at = {t: g for t, g in zip(self.stats["time"], self.stats["gap"])}
+        h_first = gap_at[times[0]] - mwd
+        self.assertEqual(n, max(1, int(round(h_first / self.D))))
+        # (The layer may still compact after the first sample: only roughly the final thickness.)
+        thickness = r["third_body_thickness"] / self.D
+        self.assertTrue(0.5 * thickness <= n <= 2 * thickness, "about the gap thickness over the mean diameter")
+        # Positions: layer centres over the mean gap between the wall surfaces.
+        np.testing.assert_allclose(p["y_over_h"], (p["layer"] + 0.5) / n, rtol=1e-12)
+        self.assertTrue(np.all(np.diff(p["y"]) > 0) and np.all(np.diff(p["y_over_h"]) > 0))
+        self.assertLess(p["y_over_h"][0], 1.0 / n)
+        self.assertGreater(p["y_over_h"][-1], 1 - 1.0 / n)
+        h_mean = np.mean([gap_at[t] - mwd for t in times[steady]])
+        np.testing.assert_allclose(p["y"] / p["y_over_h"], h_mean, rtol=1e-6)
+        # Every grain is counted in one layer.
+        np.testing.assert_allclose(p["n_discs"].sum(), self.N, rtol=1e-12)
+        self.assertTrue(np.all((p["solid_fraction"] > 0) & (p["solid_fraction"] < 1)))
+        # Compression positive: every frictionless compressive contact adds a
+        # positive semi-definite, symmetric term.
+        self.assertTrue(np.all(p["sigma_xx"] >= 0) and np.all(p["sigma_yy"] >= 0))
+        np.testing.assert_allclose(p["sigma_xy"], p["sigma_yx"], rtol=1e-9,
+                                   atol=1e-12 * np.abs(p["sigma_yy"]).max())
+        # Summary stresses: mean over the layers 2 .. n - 3.
+        self.assertGreaterEqual(n, 5)
+        for q in ("sigma_xx", "sigma_yy", "sigma_xy"):
+            np.testing.assert_allclose(r[q + "_mean"], p[q][2:n - 2].mean(), rtol=1e-12, err_msg=q)
+
+    def test_plots(self):
+        """Output/Plots = true: mu.png, power.png and profiles.png are real images."""
+        for name in PLOTS:
+            image = read_png(self, os.path.join(self.out, name))
+            self.assertGreater(image.shape[0], 100, name)
+            self.assertGreater(image.shape[1], 100, name)
+            self.assertGreater(np.ptp(image), 0, "%s is not blank" % name)
+
+
+class CompactionOnlyAtEndTime(TempDirTestCase):
+    """Shear start = End time is a compaction-only run (Shear cell/Shear start: "at or after
+    Simulation/End time the run only compacts")."""
+
+    def test_not_sliding(self):  # = 4.0000000000000003e-07 > 4e-07: reported, to be fixed there
+        write_prm(os.path.join(self.tmp, "case.prm"), shear_sections("60", "4e-7", "4e-7", "1e-7", "false"))
+        r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        s = read_json(os.path.join(self.tmp, "out", "summary.json"))
+        _, st = read_csv(os.path.join(self.tmp, "out", "statistics.csv"))
+        np.testing.assert_array_equal(st["power_lower_wall"], 0, "the lower wall never slides")
+        self.assertEqual(list(s["results"]), COMPACTION_RESULTS)
+        self.assertIs(s["results"]["sliding"], False)
+
+
+class Plots(TempDirTestCase):
+    """Plots of a compaction-only run: mu.png and power.png but no profiles.png; a
+    new run in the same directory deletes the plots of the previous one."""
+
+    def test_compaction_plots_and_rerun(self):
+        write_prm(os.path.join(self.tmp, "case.prm"), shear_sections("60", "1e-7", "1e-6", "1e-7", "true"))
+        out = os.path.join(self.tmp, "out")
+        r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for name in ("mu.png", "power.png"):
+            image = read_png(self, os.path.join(out, name))
+            self.assertGreater(min(image.shape[:2]), 100, name)
+        self.assertFalse(os.path.exists(os.path.join(out, "profiles.png")), "no profiles, no profiles.png")
+        # A stale profiles.png and a file of the user's; then a run without plots.
+        with open(os.path.join(out, "profiles.png"), "w") as f:
+            f.write("stale")
+        with open(os.path.join(out, "notes.txt"), "w") as f:
+            f.write("mine")
+        r = run(["run", "case.prm", "--output", "out", "--quiet", "--set", "Output/Plots=false"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(sorted(os.listdir(out)), sorted(FILES + ["profiles.csv", "notes.txt"]))
+
+    def test_plots_of_one_row(self):  # (TypeError: len() of numpy.float64): reported, to be fixed there
+        """A single statistics row (Statistics interval beyond the run) still gets its plots."""
+        sections = shear_sections("60", "1e-7", "1e-6", "1e-7", "true")
+        sections["Output"]["Statistics interval"] = "1000"
+        write_prm(os.path.join(self.tmp, "case.prm"), sections)
+        r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(self.tmp, "out", "log.txt")) as f:
+            self.assertNotIn("warning: the plots could not be made", f.read())
+        for name in ("mu.png", "power.png"):
+            read_png(self, os.path.join(self.tmp, "out", name))
+
+
+class CollisionNotSeparated(TempDirTestCase):
+    """A collision stopped before the discs touch: energy_loss and restitution_coefficient null."""
+
+    def test_null_results(self):
+        sections = {"Simulation": {"Scene": "collision", "Time step": "1e-11", "End time": "1e-10"},
+                    "Contact law": {"Law": "ELAS"},
+                    "Collision": {"Initial gap": "1e-9", "Impact velocity": "2"}}
+        write_prm(os.path.join(self.tmp, "case.prm"), sections)
+        r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        res = read_json(os.path.join(self.tmp, "out", "summary.json"))["results"]
+        self.assertIs(res["separated"], False)
+        self.assertIsNone(res["energy_loss"])
+        self.assertIsNone(res["restitution_coefficient"])
+        self.assertEqual(res["contact_duration"], 0)
 
 
 class SparseStatistics(TempDirTestCase):
     """Statistics interval > 1: rows every N steps, and always the last step."""
 
     def test_rows(self):
-        sections = dict(Compaction.SECTIONS)
-        sections["Output"] = {"Statistics interval": "7", "Field interval": "0"}
+        sections = shear_sections("60", "4e-7", "1e-6", "1e-7", "false")
+        sections["Output"].update({"Statistics interval": "7", "Field interval": "0"})
         write_prm(os.path.join(self.tmp, "case.prm"), sections)
         r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
         self.assertEqual(r.returncode, 0, r.stderr)
@@ -425,15 +794,19 @@ class SparseStatistics(TempDirTestCase):
         with h5py.File(os.path.join(self.tmp, "out", "results.h5"), "r") as f:
             self.assertEqual(f["statistics"].attrs["n_rows"], len(st["step"]))
             np.testing.assert_array_equal(f["statistics/step"][()], st["step"])
+        # The results average the rows written.
+        w = st["time"] >= s["results"]["averaging_start"]
+        np.testing.assert_allclose(s["results"]["normal_force_mean"], st["lower_wall_normal_force"][w].mean(),
+                                   rtol=1e-12)
 
 
 class FailedRun(TempDirTestCase):
-    """A run that cannot go on: exit 1, status failed, the reason in summary and log."""
+    """A run that cannot go on: exit 1, status failed, the reason in summary and log; no plots."""
 
     def test_failed(self):
-        sections = dict(Compaction.SECTIONS)
         # A detection distance longer than half the period: the contact search refuses.
-        sections["Contact law"] = {"Law": "IQS", "Detection distance": "1e-5"}
+        sections = shear_sections("60", "4e-7", "1e-6", "1e-7", "true",
+                                  **{"Contact law": {"Detection distance": "1e-5"}})
         write_prm(os.path.join(self.tmp, "case.prm"), sections)
         r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
         out = os.path.join(self.tmp, "out")
@@ -442,6 +815,7 @@ class FailedRun(TempDirTestCase):
         self.assertEqual(s["status"], "failed")
         self.assertIn("period along x", s["error"])
         self.assertEqual(s["steps"], 0)
+        self.assertEqual(s["results"], {})
         with open(os.path.join(out, "log.txt")) as f:
             log = f.read()
         self.assertIn("status failed", log)
@@ -451,6 +825,7 @@ class FailedRun(TempDirTestCase):
             self.assertEqual(f["statistics"].attrs["n_rows"], 0)
         self.assertEqual(tmp_files(out), [])
         self.assertEqual(s["n_field_snapshots"], 2)
+        self.assertEqual(sorted(os.listdir(out)), sorted(FILES + ["profiles.csv"]), "a failed run makes no plots")
 
 
 if __name__ == "__main__":

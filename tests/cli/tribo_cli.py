@@ -8,17 +8,16 @@ and calls tribo_cli.main(), which takes the tribo executable off the command
 line and runs unittest (exit status non-zero on any failure).
 
 Readers here are deliberately independent of tribo's own code: CSV through
-the csv module, JSON through json, HDF5 through h5py, VTU through VTK and
-through a small XML/base64/zlib decoder (used to check a file's structure
-before VTK sees it, since VTK may crash on malformed files).
+the csv module, JSON through json, HDF5 through h5py, PNG through matplotlib's
+image reader, VTU through VTK and through a small XML/base64/zlib decoder (used
+to check a file's structure before VTK sees it, since VTK may crash on
+malformed files).
 """
 
 import base64
 import csv
 import json
 import os
-import re
-import struct
 import subprocess
 import sys
 import tempfile
@@ -43,9 +42,15 @@ COMMON_COLUMNS = [
 #: Columns added by each scene, in this order.
 SCENE_COLUMNS = {
     "collision": ["gap", "relative_normal_velocity", "normal_force", "energy_change"],
-    "compaction": ["upper_wall_y", "upper_wall_vy", "lower_wall_normal_force",
-                   "applied_force", "solid_fraction", "power_lower_wall", "power_upper_wall"],
+    "shear": ["mu", "normal_force", "lower_wall_normal_force", "upper_wall_y", "upper_wall_vy",
+              "gap", "power_lower_wall", "power_upper_wall", "power_dissipated",
+              "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction"],
 }
+#: Columns of profiles.csv (and datasets of the HDF5 group "profiles"), in this order.
+PROFILE_COLUMNS = ["layer", "y", "y_over_h", "vx", "solid_fraction", "sigma_xx", "sigma_yy",
+                   "sigma_xy", "sigma_yx", "n_discs", "n_samples"]
+#: PNG plots of a shear run with Output/Plots = true (scripts/plot_run.py).
+PLOTS = ["mu.png", "power.png", "profiles.png"]
 
 #: Text that must never reach a user: deal.II's exception banner and stack trace.
 STACK_TRACE_MARKERS = ["An error occurred in line", "Stacktrace", "--------------------------------------------------------"]
@@ -87,7 +92,8 @@ def write_prm(path, sections, preamble=""):
 
 
 def read_csv(path):
-    """statistics.csv as (header list, {column: float array})."""
+    """statistics.csv (or a scene table such as profiles.csv) as
+    (header list, {column: float array}); a file with a header only gives empty arrays."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))
     header = rows[0]
@@ -99,6 +105,17 @@ def read_csv(path):
 def read_json(path):
     with open(path) as f:
         return json.load(f)
+
+
+def read_png(testcase, path):
+    """Check that @p path is a PNG file (signature) and read it with matplotlib's
+    image reader; returns the image array (rows x columns [x channels])."""
+    with open(path, "rb") as f:
+        testcase.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n", "%s: not a PNG file" % path)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.image
+    return matplotlib.image.imread(path)
 
 
 def read_pvd(path):
