@@ -117,6 +117,20 @@ class Study(unittest.TestCase):
         with open(os.path.join(out, "case_000", "study.prm")) as f:
             self.assertIn("Shear cell/Sliding velocity=2", f.read())
 
+    def test_a_failed_case_is_a_row_and_the_others_go_on(self):
+        # A detection distance of 1e-4 m makes the contact reach longer than half the
+        # period: the run stops with an error at its first step (RunError, exit 1).
+        with open(os.path.join(self.dir, "study.prm"), "w") as f:
+            f.write(STUDY.format(extra="").replace("Contact law/Cohesion = 0, 120",
+                                                   "Contact law/Detection distance = 1e-4, 0"))
+        out = os.path.join(self.dir, "f")
+        self.study("f")
+        with open(os.path.join(out, "study_summary.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([r["status"] for r in rows], ["failed", "complete"])
+        self.assertIn("period along x", rows[0]["error"])
+        self.assertNotEqual(rows[1]["mu_mean"], "")
+
     def test_bad_study_input_fails_before_running(self):
         with open(os.path.join(self.dir, "study.prm"), "w") as f:
             f.write(STUDY.format(extra="").replace("Cohesion = 0, 120", "Cohesion = 0, -5"))
