@@ -9,6 +9,7 @@
 #include "app/profiles.h"
 #include "app/scene.h"
 #include "app/steady_state.h"
+#include "core/errors.h"
 
 #include <algorithm>
 #include <cmath>
@@ -98,6 +99,12 @@ namespace tribo::app
           if (b != lower && b != upper)
             ke_tb += s.bodies[b].kinetic_energy();
         const double gap = s.bodies[upper].position.y() - s.bodies[lower].position.y();
+        if (gap < mean_wall_diameter)
+          throw RunError("at t = " + to_text(t) + " s the upper wall is " + to_text(gap) +
+                         " m above the lower wall, less than a wall-disc diameter: it has passed "
+                         "through the layer (contacts missed when a body moves more than the "
+                         "detection distance in one step). Use a smaller Simulation/Time step or "
+                         "a larger Contact law/Detection distance.");
 
         // Profile samples evenly spread over the shearing phase.
         const auto  &k        = prm.shear;
