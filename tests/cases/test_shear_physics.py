@@ -144,6 +144,30 @@ class ShearCell(unittest.TestCase):
         self.assertGreater(self.cohesive["results"]["mu_mean"], self.r["mu_mean"] + 0.02)
 
 
+class WallThroughLayer(unittest.TestCase):
+    """A step far too large with no compaction speed limit: the upper wall tunnels
+    through the layer. The run must stop as failed, naming the cause, not end
+    'complete' with nonsense (negative solid fraction)."""
+
+    def test_run_stops_with_the_reason(self):
+        case = CASE.replace("set Time step = 2e-9", "set Time step = 5e-8") \
+                   .replace("set Pressure ramp time = 1e-6", "set Pressure ramp time = 0\n  set Compaction speed limit = 0") \
+                   .replace("set Number of discs = 120", "set Number of discs = 60")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "case.prm")
+            with open(path, "w") as f:
+                f.write(case)
+            out = os.path.join(tmp, "out")
+            p = subprocess.run([TRIBO, "run", path, "--output", out, "--quiet"],
+                               capture_output=True, text=True, timeout=120)
+            self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+            with open(os.path.join(out, "summary.json")) as f:
+                summary = json.load(f)
+            self.assertEqual(summary["status"], "failed")
+            self.assertIn("has passed through the layer", summary["error"])
+            self.assertIn("smaller Simulation/Time step", summary["error"])
+
+
 if __name__ == "__main__":
     if len(sys.argv) < 2:
         sys.exit("usage: test_shear_physics.py PATH/TO/tribo")
