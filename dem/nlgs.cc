@@ -73,12 +73,12 @@ namespace tribo::dem
             if (check && (r_new.x() != 0 || r_new.y() != 0))
               {
                 ++active;
-                const Eigen::Vector2d dv    = u_after - c.u;
-                const Eigen::Vector2d r_bar = 0.5 * (r_old + r_new);
-                const Eigen::Vector2d wr    = c.W * r_new;
-                const double wrr  = 0.5 * ((c.W * r_old).dot(r_old) + wr.dot(r_new));
+                const Eigen::Vector2d dv     = c.W * dr; // = u_after - u_now
+                const Eigen::Vector2d r_bar  = 0.5 * (r_old + r_new);
+                const Eigen::Vector2d wr_old = c.W * r_old, wr_new = c.W * r_new;
+                const double wrr  = 0.5 * (wr_old.dot(r_old) + wr_new.dot(r_new));
                 const double dvdv = dv.squaredNorm();
-                sum_wrwr += wr.squaredNorm();
+                sum_wrwr += 0.5 * (wr_old.squaredNorm() + wr_new.squaredNorm());
                 sum_wrr += wrr;
                 sum_dvdv += dvdv;
                 sum_dvdvrr += dvdv * r_bar.squaredNorm();

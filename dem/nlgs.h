@@ -5,10 +5,14 @@
 ///
 /// Convergence is checked every `check_interval` sweeps with the norms of the
 /// established NSCD code (LMGC90, see ../shared/notes/nscd-reference.md), over the
-/// N contacts with r != 0, comparing each contact's state across one sweep:
-/// dV = u after this sweep's local solve - u after the previous one (m/s),
+/// N contacts with r != 0, comparing each contact's state before and after its
+/// local solve in the checked sweep, with W its own 2x2 Delassus block:
+/// dV = W (r_after - r_before), the change of its velocity in that solve (m/s),
 /// r_bar = (r_before + r_after)/2, WR = W r (m/s), WRR = (W r.r before + after)/2.
-/// - QuadWR = sqrt(sum |WR|^2 / N), MeanWRR = sum WRR / N;
+/// (dV is not the change of u since the previous sweep: a closed IQS contact
+/// leaves every local solve at exactly its target velocity, so that difference
+/// stays near zero however far its impulse still moves.)
+/// - QuadWR = sqrt(sum (|WR_before|^2 + |WR_after|^2)/2 / N), MeanWRR = sum WRR / N;
 /// - QuadDV = sqrt(sum |dV|^2 / N) / (QuadWR tol), MaxmDV with max |dV|^2;
 /// - QuadDVR = sqrt(sum |dV|^2 |r_bar|^2 / N) / (MeanWRR tol), MaxmDVR with the max;
 /// - MeanDVoR = sum r_bar.dV / (sum WRR tol).

@@ -36,6 +36,10 @@ subsection Contact law
   set Law = IQS
   set Cohesion range = 2.4e-8
 end
+subsection Solver
+  # 1e-4 (Quad) stalls near its sweep cap in packings this small (docs/laws.md).
+  set Tolerance = 1e-3
+end
 subsection Shear cell
   set Number of discs = 120
   set Length = {L}
@@ -150,7 +154,7 @@ class WallThroughLayer(unittest.TestCase):
     'complete' with nonsense (negative solid fraction)."""
 
     def test_run_stops_with_the_reason(self):
-        case = CASE.replace("set Time step = 2e-9", "set Time step = 5e-8") \
+        case = CASE.replace("set Time step = 2e-9", "set Time step = 2e-7") \
                    .replace("set Pressure ramp time = 1e-6", "set Pressure ramp time = 0\n  set Compaction speed limit = 0") \
                    .replace("set Number of discs = 120", "set Number of discs = 60")
         with tempfile.TemporaryDirectory() as tmp:

@@ -22,6 +22,9 @@ subsection Simulation
   set Time step = 2e-9
   set End time = 2e-6
 end
+subsection Solver
+  set Tolerance = 1e-3
+end
 subsection Shear cell
   set Number of discs = 50
   set Length = 1.2e-5
