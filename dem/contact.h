@@ -28,10 +28,22 @@ namespace tribo::dem
     Eigen::Vector2d u      = Eigen::Vector2d::Zero(); ///< local velocity after its last local solve, m/s
     Eigen::Vector2d u_free = Eigen::Vector2d::Zero(); ///< local velocity of the free motion (no impulses), m/s
     double cohesion_impulse = 0, shift = 0, compliance = 0; ///< law terms (ContactLaw::Terms)
+    /// Against a half-disc element of a BoundaryBody (dem/boundary.h): its index, else -1.
+    /// Side 0 is then the half-disc, moving with the nodes node[0], node[1] of the edge
+    /// below the contact point with weights node_weight (1 - xi, xi); body[0] and the
+    /// side-0 arms are unused.
+    int          half_disc      = -1;
+    unsigned int node[2]        = {0, 0};
+    double       node_weight[2] = {0, 0};
 
-    /// Key of the disc pair (smaller index first), for warm starts.
+    bool on_boundary() const { return half_disc >= 0; }
+
+    /// Key of the disc pair (smaller index first), or of the half-disc and the disc,
+    /// for warm starts.
     std::uint64_t key() const
     {
+      if (on_boundary())
+        return (std::uint64_t(1) << 63) | (std::uint64_t(half_disc) << 32) | disc[1];
       return (std::uint64_t(disc[0]) << 32) | disc[1];
     }
   };

@@ -17,6 +17,13 @@ namespace tribo::dem
     , distance(std::max(detection_distance, law.cohesion_range))
   {}
 
+  void MoreauJean::attach(BoundaryBody &body, double half_disc_diameter, const Vec2 &outward,
+                          double period)
+  {
+    boundary = &body;
+    half_discs = std::make_unique<HalfDiscs>(body, half_disc_diameter, outward, period);
+  }
+
   StepReport MoreauJean::step(ParticleSystem &system, double h)
   {
     StepReport        report;
@@ -25,7 +32,7 @@ namespace tribo::dem
     // Free velocities and the predicted configuration.
     state.velocity.resize(nb);
     state.inverse_mass.resize(nb);
-    std::vector<Eigen::Vector3d> v_begin(nb);
+    std::vector<Eigen::Vector3d> v_begin(nb), v_free(nb);
     std::vector<Vec2>            x_pred(nb);
     std::vector<double>          angle_pred(nb);
     for (std::size_t b = 0; b < nb; ++b)
@@ -38,6 +45,7 @@ namespace tribo::dem
           if (body.drive[k] == Drive::force)
             v[k] += h * state.inverse_mass[b][k] * body.load[k];
         state.velocity[b] = v;
+        v_free[b]         = v;
         x_pred[b]         = body.position + (1 - th) * h * body.velocity;
         angle_pred[b]     = body.angle + (1 - th) * h * body.spin;
       }
@@ -51,12 +59,35 @@ namespace tribo::dem
       }
     std::vector<Contact> found = detector.detect(system, centres, distance);
 
+    // The boundary body: free state, predicted nodes, half-disc contacts.
+    std::vector<Vec2> node_v_begin;
+    if (boundary)
+      {
+        const unsigned int nn = boundary->n_nodes();
+        boundary->predict(h);
+        std::vector<Vec2> nodes(nn);
+        node_v_begin.resize(nn);
+        state.node_velocity.resize(2 * nn);
+        for (unsigned int i = 0; i < nn; ++i)
+          {
+            node_v_begin[i] = boundary->node_velocity(i);
+            nodes[i]        = boundary->node_position(i) + (1 - th) * h * node_v_begin[i];
+            state.node_velocity.segment<2>(2 * i) = boundary->node_free_velocity(i);
+          }
+        state.node_compliance = &boundary->compliance();
+        auto on_boundary = half_discs->detect(system, centres, angle_pred, nodes, distance);
+        report.n_boundary_contacts = on_boundary.size();
+        found.insert(found.end(), on_boundary.begin(), on_boundary.end());
+      }
+
     // Geometry of H, the own Delassus blocks, law terms, free velocities, warm start.
     current.clear();
     current.reserve(found.size());
     for (Contact &c : found)
       {
         const Vec2 t(-c.normal.y(), c.normal.x());
+        if (!c.on_boundary())
+        {
         // Contact point: middle of the gap (or overlap) on the line of centres;
         // arms from each body centre = the disc's offset + the point from the disc centre.
         const Vec2 point_from0 = (system.discs[c.disc[0]].radius + 0.5 * c.gap) * c.normal;
@@ -67,6 +98,7 @@ namespace tribo::dem
         c.arm_t[0] = cross(arm0, t);
         c.arm_n[1] = cross(arm1, c.normal);
         c.arm_t[1] = cross(arm1, t);
+        }
         c.W        = state.delassus_block(c);
         if (c.W(0, 0) <= 0)
           continue; // both bodies have imposed velocities: nothing to solve
@@ -104,11 +136,16 @@ namespace tribo::dem
 
     // Contact force on every body over the step.
     body_force.assign(nb, Eigen::Vector3d::Zero());
+    if (boundary)
+      node_impulse.assign(boundary->n_nodes(), Vec2::Zero());
     for (const Contact &c : current)
       {
         const Vec2 t(-c.normal.y(), c.normal.x());
         const Vec2 f = (c.r.x() * c.normal + c.r.y() * t) / h;
-        for (int s = 0; s < 2; ++s)
+        if (c.on_boundary())
+          for (int k = 0; k < 2; ++k)
+            node_impulse[c.node[k]] -= c.node_weight[k] * h * f;
+        for (int s = c.on_boundary() ? 1 : 0; s < 2; ++s)
           {
             const double sign = s == 0 ? -1.0 : 1.0;
             body_force[c.body[s]] +=
@@ -120,8 +157,14 @@ namespace tribo::dem
     body_power.assign(nb, 0.0);
     for (std::size_t b = 0; b < nb; ++b)
       {
-        RigidBody             &body = system.bodies[b];
-        const Eigen::Vector3d &v    = state.velocity[b];
+        RigidBody &body = system.bodies[b];
+        // v_end = v_free + M^-1 (total contact impulse), recomputed from the final
+        // impulses rather than taken from the solver's running velocities (which
+        // carry the round-off of every incremental update): the energy balance is
+        // then exact to the last digits.
+        Eigen::Vector3d v = v_free[b];
+        for (int k = 0; k < 3; ++k)
+          v[k] += h * state.inverse_mass[b][k] * body_force[b][k];
         if (!v.allFinite())
           {
             std::ostringstream os;
@@ -151,6 +194,23 @@ namespace tribo::dem
             const double shift = system.period * std::floor(body.position.x() / system.period);
             body.position.x() -= shift;
           }
+      }
+    if (boundary)
+      {
+        const unsigned int nn = boundary->n_nodes();
+        if (!state.node_velocity.allFinite())
+          throw RunError("the boundary body's nodes have non-finite velocities: the solver diverged");
+        boundary->finalize(node_impulse);
+        // With the body's own end velocities (not the solver's running copy, which
+        // carries the round-off of many incremental updates), the balance is exact.
+        for (unsigned int i = 0; i < nn; ++i)
+          {
+            const Vec2 v_mid = 0.5 * (node_v_begin[i] + boundary->node_velocity(i));
+            report.power_contacts += node_impulse[i].dot(v_mid) / h;
+          }
+        report.power_external += boundary->external_power();
+        report.boundary_energy      = boundary->energy();
+        report.boundary_dissipation = boundary->internal_dissipation();
       }
     report.kinetic_energy = system.kinetic_energy();
     return report;

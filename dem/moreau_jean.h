@@ -8,6 +8,7 @@
 /// Imposed-velocity dofs keep their velocity. Impulses are warm-started from
 /// the previous step's contact between the same two discs.
 
+#include "dem/boundary.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
 #include "dem/nlgs.h"
@@ -15,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -39,6 +41,12 @@ namespace tribo::dem
     double power_free = 0;
     /// Power of the contact forces on all bodies, W/m (<= 0: dissipation).
     double power_contacts = 0;
+    /// With a BoundaryBody: its energy (kinetic + elastic) after the step, J/m, and the
+    /// power dissipated inside it over the step, W/m. Then KE_{i+1} + E_{i+1} - KE_i - E_i
+    /// = h (power_external + power_contacts - boundary_dissipation).
+    double boundary_energy      = 0;
+    double boundary_dissipation = 0;
+    unsigned int n_boundary_contacts = 0; ///< contacts with half-disc elements
   };
 
   /// The integrator; it owns the contacts of the current step.
@@ -48,7 +56,12 @@ namespace tribo::dem
     MoreauJean(double theta, const ContactLaw &law, const NlgsParameters &solver,
                double detection_distance);
 
-    /// Advance @p system by one step @p h (s).
+    /// Couple @p body (not owned; it must outlive this) to the discs through half-disc
+    /// elements of diameter @p half_disc_diameter (m) facing @p outward, periodic with
+    /// the system's period (dem/boundary.h). Its loads, energy and power join the step's.
+    void attach(BoundaryBody &body, double half_disc_diameter, const Vec2 &outward, double period);
+
+    /// Advance @p system (and the attached boundary body) by one step @p h (s).
     StepReport step(ParticleSystem &system, double h);
 
     /// Contacts of the last step with their impulses (N s/m).
@@ -74,5 +87,8 @@ namespace tribo::dem
     std::vector<Eigen::Vector3d> body_force;
     std::vector<double>          body_power;
     std::vector<Vec2>        centres;
+    BoundaryBody               *boundary = nullptr;
+    std::unique_ptr<HalfDiscs>  half_discs;
+    std::vector<Vec2>           node_impulse;
   };
 } // namespace tribo::dem

@@ -6,11 +6,49 @@
 
 namespace tribo::dem
 {
+  Eigen::Vector2d BodyState::boundary_local_velocity(const Contact &c) const
+  {
+    const Eigen::Vector3d &v1 = velocity[c.body[1]];
+    const Vec2             t(-c.normal.y(), c.normal.x());
+    const Vec2             dv = v1.head<2>() - half_disc_velocity(c);
+    return {c.normal.dot(dv) + c.arm_n[1] * v1.z(), t.dot(dv) + c.arm_t[1] * v1.z()};
+  }
+
+  void BodyState::apply_boundary_impulse(const Contact &c, const Eigen::Vector2d &dr)
+  {
+    const Vec2 t(-c.normal.y(), c.normal.x());
+    const Vec2 f = dr.x() * c.normal + dr.y() * t;
+    const auto &im = inverse_mass[c.body[1]];
+    Eigen::Vector3d &v = velocity[c.body[1]];
+    v.x() += im[0] * f.x();
+    v.y() += im[1] * f.y();
+    v.z() += im[2] * (c.arm_n[1] * dr.x() + c.arm_t[1] * dr.y());
+    // The nodes receive -(1 - xi) f and -xi f: two column pairs of the compliance.
+    const Eigen::MatrixXd &G = *node_compliance;
+    for (int k = 0; k < 2; ++k)
+      node_velocity.noalias() -= G.middleCols<2>(2 * c.node[k]) * (c.node_weight[k] * f);
+  }
+
   Eigen::Matrix2d BodyState::delassus_block(const Contact &c) const
   {
     const Vec2      t(-c.normal.y(), c.normal.x());
     Eigen::Matrix2d W = Eigen::Matrix2d::Zero();
-    for (int s = 0; s < 2; ++s)
+    if (c.on_boundary())
+      {
+        // B: (r_n, r_t) -> impulses on the two nodes (4 components).
+        Eigen::Matrix<double, 4, 2> B;
+        for (int k = 0; k < 2; ++k)
+          {
+            B.block<2, 1>(2 * k, 0) = -c.node_weight[k] * c.normal;
+            B.block<2, 1>(2 * k, 1) = -c.node_weight[k] * t;
+          }
+        Eigen::Matrix4d G;
+        for (int a = 0; a < 2; ++a)
+          for (int b = 0; b < 2; ++b)
+            G.block<2, 2>(2 * a, 2 * b) = node_compliance->block<2, 2>(2 * c.node[a], 2 * c.node[b]);
+        W = B.transpose() * G * B;
+      }
+    for (int s = c.on_boundary() ? 1 : 0; s < 2; ++s)
       {
         const auto &im = inverse_mass[c.body[s]];
         // Columns of H_b: generalized impulse (Fx, Fy, torque) of a unit r_n and r_t.

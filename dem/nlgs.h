@@ -73,10 +73,16 @@ namespace tribo::dem
   {
     std::vector<Eigen::Vector3d>       velocity;
     std::vector<std::array<double, 3>> inverse_mass;
+    /// Velocities of the boundary nodes of a BoundaryBody (2n: x, y per node), m/s,
+    /// and its compliance (dem/boundary.h); empty / null without one.
+    Eigen::VectorXd        node_velocity;
+    const Eigen::MatrixXd *node_compliance = nullptr;
 
     /// Local velocity of contact @p c from the current body velocities.
     Eigen::Vector2d local_velocity(const Contact &c) const
     {
+      if (c.on_boundary())
+        return boundary_local_velocity(c);
       const Eigen::Vector3d &v0 = velocity[c.body[0]], &v1 = velocity[c.body[1]];
       const Vec2             t(-c.normal.y(), c.normal.x());
       return {c.normal.dot(v1.head<2>() - v0.head<2>()) + c.arm_n[1] * v1.z() - c.arm_n[0] * v0.z(),
@@ -86,6 +92,8 @@ namespace tribo::dem
     /// Apply impulse @p dr of contact @p c: v_1 += M_1^-1 H_1 dr, v_0 -= M_0^-1 H_0 dr.
     void apply_impulse(const Contact &c, const Eigen::Vector2d &dr)
     {
+      if (c.on_boundary())
+        return apply_boundary_impulse(c, dr);
       const Vec2 t(-c.normal.y(), c.normal.x());
       const Vec2 f = dr.x() * c.normal + dr.y() * t;
       for (int s = 0; s < 2; ++s)
@@ -99,8 +107,22 @@ namespace tribo::dem
         }
     }
 
-    /// The own Delassus block of @p c, sum over its two bodies of H^T M^-1 H.
+    /// The own Delassus block of @p c, sum over its two bodies of H^T M^-1 H (for a
+    /// half-disc contact: the grain's part plus B^T G_AB B, with B the 4x2 map from
+    /// (r_n, r_t) to the impulses -(1 - xi) f, -xi f on its two nodes).
     Eigen::Matrix2d delassus_block(const Contact &c) const;
+
+    /// Side 0 of a half-disc contact: velocity of its point, interpolated from the
+    /// nodes with the weights (1 - xi, xi), m/s.
+    Vec2 half_disc_velocity(const Contact &c) const
+    {
+      return c.node_weight[0] * node_velocity.segment<2>(2 * c.node[0]) +
+             c.node_weight[1] * node_velocity.segment<2>(2 * c.node[1]);
+    }
+
+  private:
+    Eigen::Vector2d boundary_local_velocity(const Contact &c) const;
+    void            apply_boundary_impulse(const Contact &c, const Eigen::Vector2d &dr);
   };
 
   /// The solver; it keeps its random generator across steps (reproducible from the seed).

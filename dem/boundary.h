@@ -1,0 +1,104 @@
+#pragma once
+/// @file The coupling interface (../shared/DESIGN.md section 3) for first bodies that
+/// are not rigid clumps, and the hybrid half-disc elements that let grains touch them.
+///
+/// The NSCD solver sees such a body only through a periodic chain of boundary nodes:
+/// their positions and velocities at the start of a step, their free velocities
+/// (no contact impulse), and the compliance that maps node impulses to node
+/// velocity changes. A deal.II body (fem/), an SPH or an MLP body implements it; the
+/// rigid clumps stay in ParticleSystem, where their compliance is closed form.
+///
+/// Hybrid half-disc elements (Cao et al. 2011, section 2.1 and Fig. 4): rigid
+/// half-discs of diameter D with their flat side on the chain and their round side
+/// towards the third body. Rule, the same for the three cases of the paper's Fig. 4
+/// (D larger than, equal to or smaller than the edge length l):
+/// - n_h = max(1, round(period / D)) half-discs, centred at the reference abscissae
+///   s_k = (k + 1/2) period / n_h; a half-disc's centre follows the chain at s_k
+///   (linear interpolation between the two nodes of the edge that holds s_k);
+/// - a grain touches half-disc k when its centre is on the round side; the contact
+///   point P is on the line of centres, in the middle of the gap;
+/// - the contact force F goes to the two nodes A, B of the edge that holds the
+///   projection of P on the chain (abscissa s_P = s_k + (P - c_k)_x: the chain runs
+///   along x), as F_A = F (1 - xi), F_B = F xi with xi = d_p / d (Cao eq. 2), and
+///   the half-disc's velocity at P is interpolated with the same weights, so the
+///   velocity map is exactly the transpose of the force map.
+/// With D = l each half-disc sits on one edge (the paper's choice); with D > l a
+/// half-disc spans several edges and each contact loads the edge below its point;
+/// with D < l several half-discs share an edge and their forces add on its two nodes.
+
+#include "dem/particle_system.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace tribo::dem
+{
+  struct Contact;
+
+  /// A first body seen by the solver through its boundary nodes (units per unit depth).
+  class BoundaryBody
+  {
+  public:
+    virtual ~BoundaryBody() = default;
+
+    /// Number of boundary nodes; node i and node (i + 1) % n end edge i. Nodes are
+    /// ordered by increasing reference x in [0, period).
+    virtual unsigned int n_nodes() const = 0;
+    /// Position of node @p i at the start of the step, m.
+    virtual Vec2 node_position(unsigned int i) const = 0;
+    /// Velocity of node @p i at the start of the step, m/s.
+    virtual Vec2 node_velocity(unsigned int i) const = 0;
+    /// Compute the free state of a step @p h (s): the velocities without contact impulses.
+    virtual void predict(double h) = 0;
+    /// Free velocity of node @p i (after predict()), m/s.
+    virtual Vec2 node_free_velocity(unsigned int i) const = 0;
+    /// Compliance G (2n x 2n, m/s per N s/m): node velocities change by G R for node
+    /// impulses R, index 2i for x and 2i + 1 for y of node i. Constant while the step is.
+    virtual const Eigen::MatrixXd &compliance() const = 0;
+    /// Complete the step with the node impulses @p impulses (N s/m, one per node).
+    virtual void finalize(const std::vector<Vec2> &impulses) = 0;
+    /// Kinetic plus stored (elastic) energy at the end of the last step, J/m.
+    virtual double energy() const = 0;
+    /// Power of the body's external loads over the last step, W/m.
+    virtual double external_power() const = 0;
+    /// Power dissipated inside the body (damping) over the last step, W/m (>= 0).
+    virtual double internal_dissipation() const = 0;
+  };
+
+  /// Placement and contacts of the half-disc elements on a BoundaryBody's chain.
+  class HalfDiscs
+  {
+  public:
+    /// Half-discs of diameter @p diameter (m) on the chain of @p body, whose round
+    /// side faces @p outward (unit vector, e.g. (0, -1) for the bottom face of an
+    /// upper body), periodic with @p period (m). Reads the reference abscissae.
+    HalfDiscs(const BoundaryBody &body, double diameter, const Vec2 &outward, double period);
+
+    unsigned int count() const { return centre_abscissa.size(); }
+    double       radius() const { return 0.5 * diameter; }
+
+    /// Centres of the half-discs for node positions @p nodes (m, not wrapped).
+    std::vector<Vec2> centres(const std::vector<Vec2> &nodes) const;
+
+    /// Contacts of the discs of @p system (centres @p disc_centres, wrapped into
+    /// [0, period)) with the half-discs at node positions @p nodes, for gaps up to
+    /// @p distance. Fills geometry, node indices and weights; side 0 is the
+    /// half-disc, side 1 the grain's body (its arms are set).
+    std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &disc_centres,
+                                const std::vector<double> &disc_angles_of_bodies,
+                                const std::vector<Vec2> &nodes, double distance) const;
+
+  private:
+    /// Edge holding abscissa @p s (wrapped) and the weight xi of its second node.
+    std::pair<unsigned int, double> locate(double s) const;
+    /// Position on the chain at abscissa @p s for node positions @p nodes.
+    Vec2 point_at(double s, const std::vector<Vec2> &nodes) const;
+
+    double              diameter;
+    Vec2                outward;
+    double              period;
+    std::vector<double> node_abscissa;   ///< reference x of the nodes, increasing
+    std::vector<double> centre_abscissa; ///< s_k
+  };
+} // namespace tribo::dem

@@ -1,0 +1,279 @@
+// Half-disc elements and the BoundaryBody coupling interface (dem/boundary.h),
+// against a chain of lumped point masses whose compliance is diagonal.
+#include "dem/boundary.h"
+#include "dem/moreau_jean.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace tribo::dem;
+
+namespace
+{
+  /// n free point masses m on y = y_face at x = i L / n, with a load per node.
+  class LumpedChain : public BoundaryBody
+  {
+  public:
+    LumpedChain(unsigned int n, double L, double y_face, double m, Vec2 load = Vec2::Zero(), double theta = 0.5)
+      : m(m), load(load), theta(theta), x(n), v(n, Vec2::Zero()), v_free(n), G(Eigen::MatrixXd::Identity(2 * n, 2 * n) / m)
+    {
+      for (unsigned int i = 0; i < n; ++i)
+        x[i] = {i * L / n, y_face};
+    }
+    unsigned int n_nodes() const override { return x.size(); }
+    Vec2 node_position(unsigned int i) const override { return x[i]; }
+    Vec2 node_velocity(unsigned int i) const override { return v[i]; }
+    void predict(double h_) override
+    {
+      h = h_;
+      for (unsigned int i = 0; i < x.size(); ++i)
+        v_free[i] = v[i] + h * load / m;
+    }
+    Vec2 node_free_velocity(unsigned int i) const override { return v_free[i]; }
+    const Eigen::MatrixXd &compliance() const override { return G; }
+    void finalize(const std::vector<Vec2> &R) override
+    {
+      power = 0;
+      for (unsigned int i = 0; i < x.size(); ++i)
+        {
+          const Vec2 v_end = v_free[i] + R[i] / m;
+          power += load.dot(0.5 * (v[i] + v_end));
+          x[i] += h * (theta * v_end + (1 - theta) * v[i]);
+          v[i] = v_end;
+        }
+    }
+    double energy() const override
+    {
+      double e = 0;
+      for (const Vec2 &vi : v)
+        e += 0.5 * m * vi.squaredNorm();
+      return e;
+    }
+    double external_power() const override { return power; }
+    double internal_dissipation() const override { return 0; }
+    Vec2 momentum() const
+    {
+      Vec2 p = Vec2::Zero();
+      for (const Vec2 &vi : v)
+        p += m * vi;
+      return p;
+    }
+
+    double m;
+    Vec2   load;
+    double theta, h = 0, power = 0;
+    std::vector<Vec2> x, v, v_free;
+    Eigen::MatrixXd   G;
+  };
+
+  constexpr double L = 8e-6, l = 1e-6, y_face = 5e-6, rho = 7800;
+
+  /// Contacts of one grain of radius r at @p x with half-discs of diameter D on a chain.
+  std::vector<Contact> contacts_of_grain(const Vec2 &x, double r, double D, double distance = 1e-7)
+  {
+    LumpedChain    chain(8, L, y_face, 1e-8);
+    ParticleSystem s;
+    s.period = L;
+    s.add_disc(x, r, rho);
+    HalfDiscs hd(chain, D, {0, -1}, L);
+    return hd.detect(s, {s.wrap(x)}, {0.0}, chain.x, distance);
+  }
+} // namespace
+
+TEST(HalfDiscs, PlacementFollowsTheDiameter)
+{
+  LumpedChain chain(8, L, y_face, 1e-8);
+  EXPECT_EQ(HalfDiscs(chain, l, {0, -1}, L).count(), 8u);     // D = l: one per edge
+  EXPECT_EQ(HalfDiscs(chain, 2 * l, {0, -1}, L).count(), 4u); // D > l: spans two edges
+  EXPECT_EQ(HalfDiscs(chain, 0.5 * l, {0, -1}, L).count(), 16u); // D < l: two per edge
+  // D = l: centres at the edge midpoints (node i at i l, edge i ends at node i + 1).
+  const auto c = HalfDiscs(chain, l, {0, -1}, L).centres(chain.x);
+  EXPECT_NEAR(c[3].x(), 3.5 * l, 1e-18);
+  EXPECT_NEAR(c[3].y(), y_face, 1e-18);
+}
+
+TEST(HalfDiscs, ContactBelowAnEdgeMidpointSplitsTheForceEvenly)
+{
+  // Half-disc 2 is centred at x = 2.5 l; a grain straight below it at gap 2e-8.
+  const double r = 0.6e-6;
+  const auto   cs = contacts_of_grain({2.5 * l, y_face - 0.5 * l - r - 2e-8}, r, l);
+  ASSERT_EQ(cs.size(), 1u);
+  const Contact &c = cs[0];
+  EXPECT_EQ(c.half_disc, 2);
+  EXPECT_NEAR(c.gap, 2e-8, 1e-15);
+  EXPECT_NEAR(c.normal.y(), -1.0, 1e-12); // from the half-disc to the grain
+  EXPECT_EQ(c.node[0], 2u);               // edge 2: nodes 2 and 3
+  EXPECT_EQ(c.node[1], 3u);
+  EXPECT_NEAR(c.node_weight[0], 0.5, 1e-12);
+  EXPECT_NEAR(c.node_weight[1], 0.5, 1e-12);
+}
+
+TEST(HalfDiscs, OffCentreContactUsesTheEdgeBelowItsPoint)
+{
+  // A grain below and to the right of half-disc 2 along 45 degrees: contact point at
+  // x = 2.5 l + (D/2 + gap/2) cos 45, with D = 2 l (spanning edges) it lies on a later edge.
+  const double r = 0.5e-6, D = 2 * l, gap = 1e-8;
+  const double a = (0.5 * D + r + gap) / std::sqrt(2.0);
+  // With D = 2 l the half-discs sit at (k + 1/2) 2 l: half-disc 1 at x = 3 l.
+  const auto cs = contacts_of_grain({3 * l + a, y_face - a}, r, D, 2e-8);
+  const double xp = 3 * l + (0.5 * D + 0.5 * gap) / std::sqrt(2.0);
+  // Node i is at i l: the edge holding xp and its weight.
+  const unsigned int e  = unsigned(std::floor(xp / l));
+  const double       xi = xp / l - e;
+  ASSERT_EQ(e, 3u); // 3.71 l: half-disc 1 spans edges 2 and 3, the point is on edge 3
+  unsigned found = 0;
+  for (const auto &c : cs)
+    if (c.half_disc == 1)
+      {
+        ++found;
+        EXPECT_NEAR(c.gap, gap, 1e-15);
+        EXPECT_EQ(c.node[0], e);
+        EXPECT_EQ(c.node[1], e + 1);
+        EXPECT_NEAR(c.node_weight[1], xi, 1e-9);
+        EXPECT_NEAR(c.node_weight[0], 1 - xi, 1e-9);
+      }
+  EXPECT_EQ(found, 1u);
+}
+
+TEST(HalfDiscs, DetectedAcrossThePeriodicBoundary)
+{
+  // A grain at x = 0.05 l touches half-disc 0 (x = 0.5 l) and, across the boundary,
+  // half-disc 7 (x = 7.5 l, image at -0.5 l), whose contact point lies at about
+  // -0.26 l, i.e. 7.74 l on the wrapping edge 7 (node 7 -> node 0).
+  const double r = 0.5e-6;
+  const auto   cs = contacts_of_grain({0.05 * l, y_face - 0.5 * l - r}, r, l, 0.3e-6);
+  std::vector<int> seen;
+  for (const auto &c : cs)
+    seen.push_back(c.half_disc);
+  EXPECT_NE(std::find(seen.begin(), seen.end(), 0), seen.end());
+  ASSERT_NE(std::find(seen.begin(), seen.end(), 7), seen.end());
+  for (const auto &c : cs)
+    if (c.half_disc == 7)
+      {
+        EXPECT_GT(c.normal.x(), 0.0); // the grain is to the right of half-disc 7's image
+        const double xp = -0.5 * l + (0.5 * l + 0.5 * c.gap) * c.normal.x() + L;
+        EXPECT_EQ(c.node[0], 7u);
+        EXPECT_EQ(c.node[1], 0u);
+        EXPECT_NEAR(c.node_weight[1], xp / l - 7, 1e-9);
+      }
+}
+
+TEST(HalfDiscs, VelocityMapIsTheTransposeOfTheForceMap)
+{
+  // u . r = qdot . (H r) for random velocities and impulses: the half-disc side's
+  // interpolated velocity and its split impulse are adjoint, and so is the grain's side.
+  std::mt19937                           gen(3);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int trial = 0; trial < 20; ++trial)
+    {
+      const double r  = 0.6e-6;
+      const double dx = 0.4e-6 * U(gen), D = (trial % 3 + 1) * 0.5 * l;
+      const auto   cs = contacts_of_grain({4.25 * l + dx, y_face - 0.5 * D - r + 0.2 * r * U(gen)}, r, D, 0.4e-6);
+      ASSERT_FALSE(cs.empty());
+      Contact c = cs[0];
+      c.body[0] = c.body[1] = 0;
+      c.arm_n[1] = 1e-7 * U(gen); // some moment arm for the grain's spin
+      c.arm_t[1] = 1e-7 * U(gen);
+      const unsigned int n = 8;
+      // Random velocities: u = H^T qdot.
+      BodyState vel;
+      vel.velocity        = {Eigen::Vector3d(U(gen), U(gen), 1e6 * U(gen))};
+      vel.inverse_mass    = {{{1, 1, 1}}};
+      vel.node_velocity   = Eigen::VectorXd::NullaryExpr(2 * n, [&]() { return U(gen); });
+      Eigen::MatrixXd I   = Eigen::MatrixXd::Identity(2 * n, 2 * n);
+      vel.node_compliance = &I;
+      const Eigen::Vector2d u = vel.local_velocity(c);
+      // H r: with unit inverse masses and compliance, apply_impulse adds H r to zero velocities.
+      const Eigen::Vector2d rr(U(gen), U(gen));
+      BodyState imp;
+      imp.velocity        = {Eigen::Vector3d::Zero()};
+      imp.inverse_mass    = {{{1, 1, 1}}};
+      imp.node_velocity   = Eigen::VectorXd::Zero(2 * n);
+      imp.node_compliance = &I;
+      imp.apply_impulse(c, rr);
+      const double lhs = u.dot(rr);
+      const double rhs = vel.velocity[0].dot(imp.velocity[0]) + vel.node_velocity.dot(imp.node_velocity);
+      EXPECT_NEAR(lhs, rhs, 1e-12 * (std::abs(lhs) + 1));
+      // And the own Delassus block is H^T G H with G = I.
+      const Eigen::Matrix2d W = imp.delassus_block(c);
+      for (int k = 0; k < 2; ++k)
+        {
+          BodyState e = imp;
+          e.velocity[0].setZero();
+          e.node_velocity.setZero();
+          e.apply_impulse(c, Eigen::Vector2d::Unit(k));
+          const Eigen::Vector2d column = e.local_velocity(c);
+          EXPECT_NEAR(column.x(), W(0, k), 1e-12);
+          EXPECT_NEAR(column.y(), W(1, k), 1e-12);
+        }
+    }
+}
+
+TEST(HalfDiscs, ImpactOnALumpedChainConservesMomentum)
+{
+  // A grain moving up at 2 m/s hits a chain of free point masses (frictionless IQS):
+  // total momentum is conserved and the contact's normal velocity ends at zero.
+  const double   r = 0.5e-6, mnode = 2e-9;
+  LumpedChain    chain(8, L, y_face, mnode);
+  ParticleSystem s;
+  s.period = L;
+  const unsigned g = s.add_disc({3.5 * l, y_face - 0.5 * l - r - 1e-9}, r, rho);
+  s.bodies[g].velocity = {0.3, 2.0};
+  NlgsParameters prm;
+  prm.tolerance      = 1e-10;
+  prm.check_interval = 1;
+  MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);
+  mj.attach(chain, l, {0, -1}, L);
+  const Vec2 p0 = s.bodies[g].mass * s.bodies[g].velocity + chain.momentum();
+  const auto rep = mj.step(s, 1e-9);
+  ASSERT_EQ(rep.n_boundary_contacts, 1u);
+  ASSERT_EQ(rep.n_active, 1u);
+  const Vec2 p1 = s.bodies[g].mass * s.bodies[g].velocity + chain.momentum();
+  EXPECT_NEAR(p1.x(), p0.x(), 1e-12 * p0.norm());
+  EXPECT_NEAR(p1.y(), p0.y(), 1e-12 * p0.norm());
+  const Contact &c = mj.contacts()[0];
+  const Vec2 v_point = (1 - c.node_weight[1]) * chain.v[c.node[0]] + c.node_weight[1] * chain.v[c.node[1]];
+  EXPECT_NEAR(c.normal.dot(s.bodies[g].velocity - v_point) + c.shift, 0.0, 1e-9); // closed at the end
+  EXPECT_GT(chain.momentum().y(), 0.0); // pushed up
+}
+
+TEST(HalfDiscs, EnergyBalanceWithABoundaryBodyClosesEveryStep)
+{
+  // Grains squeezed between a sliding rigid wall and a loaded chain of point masses:
+  // KE + E_chain changes by h (P_external + P_contacts) every step, to round-off.
+  ParticleSystem s;
+  s.period = L;
+  std::vector<Vec2>   c;
+  std::vector<double> rad;
+  for (int i = 0; i < 8; ++i)
+    {
+      c.push_back({(i + 0.5) * l, 0});
+      rad.push_back(0.5e-6);
+    }
+  const unsigned lower = s.add_clump(c, rad, rho);
+  for (auto &d : s.bodies[lower].drive)
+    d = Drive::velocity;
+  s.bodies[lower].velocity = {1.0, 0};
+  for (int i = 0; i < 24; ++i)
+    s.add_disc({(i % 8 + 0.5 + 0.3 * (i / 8 % 2)) * l, (1.05 + 1.05 * (i / 8)) * l}, 0.5e-6, rho);
+  LumpedChain chain(8, L, 4.0 * l, 2e-8, {0, -100.0});
+  NlgsParameters prm;
+  prm.tolerance = 1e-9;
+  prm.check_interval = 1;
+  MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);
+  mj.attach(chain, l, {0, -1}, L);
+  double   e0 = s.kinetic_energy() + chain.energy();
+  unsigned touched = 0;
+  for (int i = 0; i < 300; ++i)
+    {
+      const auto   rep = mj.step(s, 1e-9);
+      const double e1  = rep.kinetic_energy + rep.boundary_energy;
+      const double rhs = 1e-9 * (rep.power_external + rep.power_contacts - rep.boundary_dissipation);
+      // Round-off: a few ulps of the total (the sliding wall's 2.4e-8 J/m).
+      EXPECT_NEAR(e1 - e0, rhs, 1e-9 * (std::abs(e1 - e0) + std::abs(rhs)) + 1e-14 * e1) << "step " << i;
+      e0 = e1;
+      touched += rep.n_boundary_contacts > 0;
+    }
+  EXPECT_GT(touched, 100u);
+}
