@@ -1,0 +1,702 @@
+// The deal.II elastic body: mesh, constraints, assembly, the two direct solvers
+// (CHOLMOD, UMFPACK), the theta-scheme step, the boundary compliance, output.
+#include "fem/elastic_body.h"
+
+#include "core/errors.h"
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+#include <deal.II/numerics/data_out.h>
+#include <deal.II/numerics/vector_tools_boundary.h>
+#include <deal.II/numerics/vector_tools_point_gradient.h>
+#include <deal.II/numerics/vector_tools_point_value.h>
+
+#include <cholmod.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+namespace tribo::fem
+{
+  using namespace dealii;
+
+  namespace
+  {
+    /// A sparse direct solver for the symmetric positive definite matrix Mt.
+    class DirectSolver
+    {
+    public:
+      virtual ~DirectSolver() = default;
+      virtual void factorize(const SparseMatrix<double> &A) = 0;
+      /// Overwrite the n x k column-major block @p b with A^-1 b.
+      virtual void solve(double *b, unsigned int k) = 0;
+    };
+
+    /// deal.II's SparseDirectUMFPACK (LU of the whole matrix).
+    class UmfpackSolver : public DirectSolver
+    {
+    public:
+      void factorize(const SparseMatrix<double> &A) override
+      {
+        umfpack.factorize(A);
+        column.reinit(A.m());
+      }
+      void solve(double *b, unsigned int k) override
+      {
+        const std::size_t n = column.size();
+        for (unsigned int c = 0; c < k; ++c)
+          {
+            std::copy(b + c * n, b + (c + 1) * n, column.begin());
+            umfpack.solve(column);
+            std::copy(column.begin(), column.end(), b + c * n);
+          }
+      }
+
+    private:
+      SparseDirectUMFPACK umfpack;
+      Vector<double>      column;
+    };
+
+    /// SuiteSparse CHOLMOD (Cholesky L L^T, fill-reducing ordering by CHOLMOD's
+    /// defaults) through its C API. deal.II stores the diagonal of each row first and
+    /// the other columns increasing, so the row-wise upper part of a symmetric CSR
+    /// matrix is, column by column, its lower triangle in sorted CSC (stype -1).
+    /// Constrained rows hold only a positive diagonal entry, so A is SPD.
+    class CholmodSolver : public DirectSolver
+    {
+    public:
+      CholmodSolver() { cholmod_start(&common); }
+      ~CholmodSolver() override
+      {
+        cholmod_free_factor(&factor, &common);
+        cholmod_free_dense(&x, &common);
+        cholmod_free_dense(&y, &common);
+        cholmod_free_dense(&e, &common);
+        cholmod_finish(&common);
+      }
+      CholmodSolver(const CholmodSolver &) = delete;
+      CholmodSolver &operator=(const CholmodSolver &) = delete;
+
+      void factorize(const SparseMatrix<double> &A) override
+      {
+        const std::size_t n   = A.m();
+        std::size_t       nnz = 0;
+        for (std::size_t r = 0; r < n; ++r)
+          for (auto it = A.begin(r); it != A.end(r); ++it)
+            nnz += it->column() >= r;
+        cholmod_sparse *L =
+          cholmod_allocate_sparse(n, n, nnz, /*sorted*/ 1, /*packed*/ 1, /*stype*/ -1, CHOLMOD_REAL, &common);
+        if (L == nullptr)
+          throw RunError("CHOLMOD: cannot allocate the matrix (" + std::to_string(nnz) + " entries)");
+        auto *p = static_cast<int *>(L->p);
+        auto *i = static_cast<int *>(L->i);
+        auto *v = static_cast<double *>(L->x);
+        std::size_t k = 0;
+        for (std::size_t r = 0; r < n; ++r)
+          {
+            p[r] = static_cast<int>(k);
+            for (auto it = A.begin(r); it != A.end(r); ++it)
+              if (it->column() >= r)
+                {
+                  i[k] = static_cast<int>(it->column());
+                  v[k] = it->value();
+                  ++k;
+                }
+          }
+        p[n] = static_cast<int>(k);
+
+        cholmod_free_factor(&factor, &common);
+        factor = cholmod_analyze(L, &common);
+        const bool ok = factor != nullptr && cholmod_factorize(L, factor, &common) && common.status == CHOLMOD_OK;
+        cholmod_free_sparse(&L, &common);
+        if (!ok)
+          throw RunError("CHOLMOD: factorisation of the iteration matrix failed (status " +
+                         std::to_string(common.status) + ", not positive definite or out of memory)");
+        rows = n;
+      }
+
+      void solve(double *b, unsigned int k) override
+      {
+        cholmod_dense rhs;
+        rhs.nrow  = rows;
+        rhs.ncol  = k;
+        rhs.nzmax = rows * k;
+        rhs.d     = rows;
+        rhs.x     = b;
+        rhs.z     = nullptr;
+        rhs.xtype = CHOLMOD_REAL;
+        rhs.dtype = CHOLMOD_DOUBLE;
+        if (!cholmod_solve2(CHOLMOD_A, factor, &rhs, nullptr, &x, nullptr, &y, &e, &common))
+          throw RunError("CHOLMOD: solve failed (status " + std::to_string(common.status) + ")");
+        std::memcpy(b, x->x, sizeof(double) * rows * k);
+      }
+
+    private:
+      cholmod_common  common;
+      cholmod_factor *factor = nullptr;
+      cholmod_dense  *x = nullptr, *y = nullptr, *e = nullptr; // reused workspace
+      std::size_t     rows = 0;
+    };
+
+    constexpr types::boundary_id left_id = 0, right_id = 1, bottom_id = 2, top_id = 3;
+
+    void check(bool ok, const std::string &what)
+    {
+      if (!ok)
+        throw InputError("ElasticBody: " + what);
+    }
+
+    void check_parameters(const ElasticBodyParameters &p)
+    {
+      check(p.length > 0 && p.thickness > 0, "length and thickness must be > 0");
+      check(p.youngs_modulus > 0 && p.density > 0, "Young's modulus and density must be > 0");
+      check(p.poisson_ratio > -1 && p.poisson_ratio < 0.5, "Poisson ratio must lie in (-1, 0.5)");
+      check(p.cells_x >= 1 && p.cells_y >= 1 && p.degree >= 1, "cells and degree must be >= 1");
+      check(p.rayleigh_mass >= 0 && p.rayleigh_stiffness >= 0, "Rayleigh coefficients must be >= 0");
+      check(p.theta >= 0.5 && p.theta <= 1, "theta must lie in [0.5, 1]");
+      check(p.time_step > 0, "time step must be > 0");
+      check(p.pressure_ramp_time >= 0, "pressure ramp time must be >= 0");
+      check(p.solver == "cholmod" || p.solver == "umfpack",
+            "solver must be \"cholmod\" or \"umfpack\", not \"" + p.solver + "\"");
+    }
+
+    /// A column of the constraint matrix Z: the unconstrained dofs (and weights) a
+    /// dof's value is made of, v_d = sum_m w_m v_m; a load on d is w_m on each m.
+    using ZColumn = std::vector<std::pair<types::global_dof_index, double>>;
+  } // namespace
+
+  struct ElasticBody::Impl
+  {
+    ElasticBodyParameters prm;
+    double                lambda, mu;
+
+    Triangulation<2>          tria;
+    FESystem<2>               fe;
+    DoFHandler<2>             dof;
+    AffineConstraints<double> constraints;
+    SparsityPattern           sparsity;
+    SparseMatrix<double>      M, K, Mt; // condensed: Z^T A Z on masters, a diagonal on constrained rows
+    Vector<double>            f_unit;   // Z^T f for P = 1 Pa, N/m per Pa
+
+    Vector<double> u, v, v_free, v_prev; // v_prev: velocity at the start of the last step
+    Vector<double> rhs, tmp;
+    std::unique_ptr<DirectSolver> solver;
+
+    std::vector<Point<2>> node_position;
+    std::vector<ZColumn>  node_z; // 2n columns of Z, index 2i + component
+
+    double t = 0, h = 0;
+    bool   predicted = false;
+
+    mutable Eigen::MatrixXd compliance;
+    mutable bool            compliance_valid = false;
+
+    double p_load = 0, p_contact = 0, p_damping = 0;
+    double w_load = 0, w_contact = 0, w_damping = 0;
+
+    explicit Impl(const ElasticBodyParameters &p)
+      : prm(p)
+      , lambda(p.youngs_modulus * p.poisson_ratio / ((1 + p.poisson_ratio) * (1 - 2 * p.poisson_ratio)))
+      , mu(p.youngs_modulus / (2 * (1 + p.poisson_ratio)))
+      , fe(FE_Q<2>(p.degree), 2)
+      , h(p.time_step)
+    {}
+
+    void make_mesh();
+    void make_constraints(AffineConstraints<double> &c, bool static_problem) const;
+    void assemble(const AffineConstraints<double> &c, SparseMatrix<double> *mass, SparseMatrix<double> &stiffness,
+                  Vector<double> &load) const;
+    void find_boundary_nodes();
+    void factorize();
+    void solve(Vector<double> &b); // b := Mt^-1 b, then the constraints are distributed
+
+    /// w := A x restricted to unconstrained rows (constrained rows zeroed).
+    void vmult_free(const SparseMatrix<double> &A, const Vector<double> &x, Vector<double> &w) const
+    {
+      A.vmult(w, x);
+      constraints.set_zero(w);
+    }
+    double quadratic(const SparseMatrix<double> &A, const Vector<double> &x) const
+    {
+      Vector<double> w(x.size());
+      vmult_free(A, x, w);
+      return 0.5 * (x * w);
+    }
+    Eigen::Vector2d node_value(const Vector<double> &x, unsigned int i) const
+    {
+      Eigen::Vector2d r;
+      for (unsigned int c = 0; c < 2; ++c)
+        {
+          r[c] = 0;
+          for (const auto &[m, w] : node_z[2 * i + c])
+            r[c] += w * x[m];
+        }
+      return r;
+    }
+  };
+
+  void ElasticBody::Impl::make_mesh()
+  {
+    const Point<2> p0(0, prm.bottom), p1(prm.length, prm.bottom + prm.thickness);
+    GridGenerator::subdivided_hyper_rectangle(tria, {prm.cells_x, prm.cells_y}, p0, p1, /*colorize*/ true);
+    dof.reinit(tria);
+    dof.distribute_dofs(fe);
+  }
+
+  void ElasticBody::Impl::make_constraints(AffineConstraints<double> &c, bool static_problem) const
+  {
+    c.clear();
+    DoFTools::make_periodicity_constraints(dof, left_id, right_id, /*direction x*/ 0, c);
+    const FEValuesExtractors::Scalar x(0), y(1);
+    // Dirichlet lines are only added for dofs not yet constrained; close() then
+    // resolves periodic lines that point to a Dirichlet dof.
+    if (prm.top_fixed_in_x)
+      VectorTools::interpolate_boundary_values(dof, top_id, Functions::ZeroFunction<2>(2), c, fe.component_mask(x));
+    if (static_problem)
+      {
+        VectorTools::interpolate_boundary_values(dof, bottom_id, Functions::ZeroFunction<2>(2), c,
+                                                 fe.component_mask(y));
+        if (!prm.top_fixed_in_x) // pin x at node 0 (or at its master) against the rigid x-translation
+          for (const auto &[m, w] : node_z[0])
+            if (!c.is_constrained(m))
+              {
+                c.add_line(m);
+                break;
+              }
+      }
+    c.close();
+  }
+
+  void ElasticBody::Impl::assemble(const AffineConstraints<double> &c, SparseMatrix<double> *mass,
+                                   SparseMatrix<double> &stiffness, Vector<double> &load) const
+  {
+    const QGauss<2>     quad(prm.degree + 1);
+    const QGauss<1>     face_quad(prm.degree + 1);
+    FEValues<2>         fv(fe, quad, update_values | update_gradients | update_JxW_values);
+    FEFaceValues<2>     ffv(fe, face_quad, update_values | update_JxW_values);
+    const unsigned int  nd = fe.n_dofs_per_cell();
+    FullMatrix<double>  cm(nd, nd), ck(nd, nd);
+    Vector<double>      cf(nd);
+    std::vector<types::global_dof_index> dofs(nd);
+    const FEValuesExtractors::Vector disp(0);
+
+    for (const auto &cell : dof.active_cell_iterators())
+      {
+        fv.reinit(cell);
+        cm = 0;
+        ck = 0;
+        cf = 0;
+        for (unsigned int q = 0; q < quad.size(); ++q)
+          {
+            const double dx = fv.JxW(q);
+            for (unsigned int i = 0; i < nd; ++i)
+              {
+                const auto   phi_i = fv[disp].value(i, q);
+                const auto   eps_i = fv[disp].symmetric_gradient(i, q);
+                const double div_i = fv[disp].divergence(i, q);
+                for (unsigned int j = i; j < nd; ++j)
+                  {
+                    cm(i, j) += prm.density * (phi_i * fv[disp].value(j, q)) * dx;
+                    ck(i, j) += (lambda * div_i * fv[disp].divergence(j, q) +
+                                 2 * mu * scalar_product(eps_i, fv[disp].symmetric_gradient(j, q))) * dx;
+                  }
+              }
+          }
+        for (unsigned int i = 0; i < nd; ++i)
+          for (unsigned int j = 0; j < i; ++j)
+            {
+              cm(i, j) = cm(j, i);
+              ck(i, j) = ck(j, i);
+            }
+        for (const auto f : cell->face_indices())
+          if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == top_id)
+            {
+              ffv.reinit(cell, f);
+              for (unsigned int q = 0; q < face_quad.size(); ++q)
+                for (unsigned int i = 0; i < nd; ++i) // traction (0, -1 Pa)
+                  cf(i) -= ffv[disp].value(i, q)[1] * ffv.JxW(q);
+            }
+        cell->get_dof_indices(dofs);
+        if (mass)
+          c.distribute_local_to_global(cm, dofs, *mass);
+        c.distribute_local_to_global(ck, cf, dofs, stiffness, load);
+      }
+  }
+
+  void ElasticBody::Impl::find_boundary_nodes()
+  {
+    const unsigned int n   = prm.cells_x;
+    const double       dx  = prm.length / n;
+    const unsigned int dpv = fe.n_dofs_per_vertex(); // 2: x then y (FESystem of two FE_Q)
+    std::vector<std::array<types::global_dof_index, 2>> vertex_dofs(n);
+    std::vector<bool>                                   found(n, false);
+    node_position.assign(n, Point<2>());
+    for (const auto &cell : dof.active_cell_iterators())
+      for (const auto f : cell->face_indices())
+        if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == bottom_id)
+          for (const auto v : cell->vertex_indices())
+            {
+              const Point<2> p = cell->vertex(v);
+              if (std::abs(p[1] - prm.bottom) > 1e-9 * prm.thickness)
+                continue;
+              const auto k = static_cast<unsigned int>(std::lround(p[0] / dx));
+              if (k >= n) // x = L: the periodic image of node 0
+                continue;
+              for (unsigned int d = 0; d < dpv; ++d)
+                vertex_dofs[k][fe.system_to_component_index(v * dpv + d).first] = cell->vertex_dof_index(v, d);
+              node_position[k] = Point<2>(k * dx, prm.bottom);
+              found[k]         = true;
+            }
+    AssertThrow(std::all_of(found.begin(), found.end(), [](bool b) { return b; }),
+                ExcMessage("ElasticBody: a bottom node was not found"));
+
+    node_z.assign(2 * n, ZColumn());
+    for (unsigned int k = 0; k < n; ++k)
+      for (unsigned int c = 0; c < 2; ++c)
+        {
+          const auto d = vertex_dofs[k][c];
+          if (!constraints.is_constrained(d))
+            node_z[2 * k + c] = {{d, 1.0}};
+          else
+            for (const auto &entry : *constraints.get_constraint_entries(d))
+              node_z[2 * k + c].emplace_back(entry.first, entry.second);
+        }
+  }
+
+  void ElasticBody::Impl::factorize()
+  {
+    const double th = prm.theta;
+    Mt.copy_from(M);
+    Mt *= 1 + th * h * prm.rayleigh_mass;
+    Mt.add(th * h * prm.rayleigh_stiffness + th * th * h * h, K);
+    if (!solver)
+      {
+        if (prm.solver == "cholmod")
+          solver = std::make_unique<CholmodSolver>();
+        else
+          solver = std::make_unique<UmfpackSolver>();
+      }
+    solver->factorize(Mt);
+    compliance_valid = false;
+  }
+
+  void ElasticBody::Impl::solve(Vector<double> &b)
+  {
+    constraints.set_zero(b);
+    solver->solve(b.data(), 1);
+    constraints.distribute(b);
+  }
+
+  ElasticBody::ElasticBody(const ElasticBodyParameters &parameters)
+  {
+    check_parameters(parameters);
+    impl = std::make_unique<Impl>(parameters);
+    Impl &m = *impl;
+    m.make_mesh();
+    m.make_constraints(m.constraints, false);
+    m.find_boundary_nodes();
+
+    DynamicSparsityPattern dsp(m.dof.n_dofs());
+    DoFTools::make_sparsity_pattern(m.dof, dsp, m.constraints, /*keep_constrained_dofs*/ false);
+    m.sparsity.copy_from(dsp);
+    m.M.reinit(m.sparsity);
+    m.K.reinit(m.sparsity);
+    m.Mt.reinit(m.sparsity);
+    m.f_unit.reinit(m.dof.n_dofs());
+    m.assemble(m.constraints, &m.M, m.K, m.f_unit);
+
+    for (auto *x : {&m.u, &m.v, &m.v_free, &m.v_prev, &m.rhs, &m.tmp})
+      x->reinit(m.dof.n_dofs());
+    m.factorize();
+  }
+
+  ElasticBody::~ElasticBody()                                  = default;
+  ElasticBody::ElasticBody(ElasticBody &&) noexcept            = default;
+  ElasticBody &ElasticBody::operator=(ElasticBody &&) noexcept = default;
+
+  const ElasticBodyParameters &ElasticBody::parameters() const { return impl->prm; }
+  unsigned int ElasticBody::n_dofs() const { return impl->dof.n_dofs(); }
+  double ElasticBody::lame_lambda() const { return impl->lambda; }
+  double ElasticBody::shear_modulus() const { return impl->mu; }
+  double ElasticBody::time() const { return impl->t; }
+  double ElasticBody::time_step() const { return impl->h; }
+
+  double ElasticBody::pressure(double t) const
+  {
+    const auto &p = impl->prm;
+    if (t < 0)
+      return 0;
+    return p.pressure_ramp_time > 0 ? p.top_pressure * std::min(1.0, t / p.pressure_ramp_time) : p.top_pressure;
+  }
+
+  void ElasticBody::set_time_step(double h)
+  {
+    if (!(h > 0))
+      throw InputError("ElasticBody: time step must be > 0, not " + to_text(h));
+    if (h == impl->h)
+      return;
+    impl->h = h;
+    impl->prm.time_step = h;
+    impl->factorize();
+    impl->predicted = false;
+  }
+
+  // Mt (v_free - v) = h (f - a M v - K (u + (theta h + b) v)), the increment form of
+  // Mt v_free = (M - h(1-theta) C - h^2 theta(1-theta) K) v - h K u + h f.
+  void ElasticBody::predict()
+  {
+    Impl      &m  = *impl;
+    const auto &p = m.prm;
+    m.tmp = m.u;
+    m.tmp.add(p.theta * m.h + p.rayleigh_stiffness, m.v);
+    m.K.vmult(m.rhs, m.tmp);
+    if (p.rayleigh_mass != 0)
+      {
+        m.M.vmult(m.tmp, m.v);
+        m.rhs.add(p.rayleigh_mass, m.tmp);
+      }
+    m.rhs.sadd(-m.h, m.h * pressure(m.t + p.theta * m.h), m.f_unit);
+    m.solve(m.rhs);
+    m.v_free = m.v;
+    m.v_free += m.rhs;
+    m.predicted = true;
+  }
+
+  // v_end = v_free + Mt^-1 Z^T R,  u_end = u + h (theta v_end + (1 - theta) v).
+  void ElasticBody::finalize(const std::vector<Eigen::Vector2d> &R)
+  {
+    Impl       &m = *impl;
+    const auto &p = m.prm;
+    const unsigned int n = n_boundary_nodes();
+    if (!m.predicted)
+      throw RunError("ElasticBody::finalize: predict() was not called for this step");
+    if (!R.empty() && R.size() != n)
+      throw RunError("ElasticBody::finalize: " + std::to_string(R.size()) + " impulses for " +
+                     std::to_string(n) + " boundary nodes");
+    const bool has_impulses = std::any_of(R.begin(), R.end(), [](const Eigen::Vector2d &r) { return r != Eigen::Vector2d::Zero(); });
+
+    double contact_work = 0; // sum_i R_i . (v_i + v_end,i) / 2
+    for (unsigned int i = 0; i < R.size(); ++i)
+      contact_work += 0.5 * R[i].dot(m.node_value(m.v, i));
+
+    std::swap(m.v_prev, m.v); // v_prev: start of the step
+    m.v = m.v_free;
+    if (has_impulses)
+      {
+        m.rhs = 0;
+        for (unsigned int i = 0; i < n; ++i)
+          for (unsigned int c = 0; c < 2; ++c)
+            for (const auto &[d, w] : m.node_z[2 * i + c])
+              m.rhs[d] += w * R[i][c];
+        m.solve(m.rhs);
+        m.v += m.rhs;
+      }
+    for (unsigned int i = 0; i < R.size(); ++i)
+      contact_work += 0.5 * R[i].dot(m.node_value(m.v, i));
+    m.u.add(m.h * p.theta, m.v, m.h * (1 - p.theta), m.v_prev);
+
+    // vbar = (v + v_end) / 2 in rhs; f(t + theta h).vbar
+    m.rhs = m.v;
+    m.rhs += m.v_prev;
+    m.rhs *= 0.5;
+    m.p_load    = pressure(m.t + p.theta * m.h) * (m.f_unit * m.rhs);
+    m.p_contact = contact_work / m.h;
+    m.p_damping = 0;
+    if (p.rayleigh_mass != 0 || p.rayleigh_stiffness != 0)
+      {
+        Vector<double> v_theta(m.v), cv(m.v.size());
+        v_theta.sadd(p.theta, 1 - p.theta, m.v_prev);
+        m.M.vmult(m.tmp, v_theta);
+        m.K.vmult(cv, v_theta);
+        cv.sadd(p.rayleigh_stiffness, p.rayleigh_mass, m.tmp);
+        m.constraints.set_zero(cv);
+        m.p_damping = m.rhs * cv;
+      }
+    m.w_load += m.h * m.p_load;
+    m.w_contact += contact_work;
+    m.w_damping += m.h * m.p_damping;
+    m.t += m.h;
+    m.predicted = false;
+  }
+
+  unsigned int ElasticBody::n_boundary_nodes() const { return impl->node_position.size(); }
+
+  Eigen::Vector2d ElasticBody::boundary_position(unsigned int i) const
+  {
+    const auto &x = impl->node_position.at(i);
+    return {x[0], x[1]};
+  }
+  Eigen::Vector2d ElasticBody::boundary_displacement(unsigned int i) const { return impl->node_value(impl->u, i); }
+  Eigen::Vector2d ElasticBody::boundary_free_velocity(unsigned int i) const { return impl->node_value(impl->v_free, i); }
+  Eigen::Vector2d ElasticBody::boundary_velocity(unsigned int i) const { return impl->node_value(impl->v, i); }
+
+  // G = Z_b^T Mt^-1 Z_b, solved in blocks of columns.
+  const Eigen::MatrixXd &ElasticBody::boundary_compliance() const
+  {
+    Impl &m = *impl;
+    if (m.compliance_valid)
+      return m.compliance;
+    const unsigned int  nc = m.node_z.size(), block = 32;
+    const std::size_t   N  = m.dof.n_dofs();
+    std::vector<double> B(N * block);
+    m.compliance.resize(nc, nc);
+    for (unsigned int start = 0; start < nc; start += block)
+      {
+        const unsigned int k = std::min(block, nc - start);
+        std::fill(B.begin(), B.end(), 0.0);
+        for (unsigned int c = 0; c < k; ++c)
+          for (const auto &[d, w] : m.node_z[start + c])
+            B[c * N + d] += w;
+        m.solver->solve(B.data(), k);
+        for (unsigned int c = 0; c < k; ++c)
+          for (unsigned int r = 0; r < nc; ++r)
+            {
+              double g = 0;
+              for (const auto &[d, w] : m.node_z[r])
+                g += w * B[c * N + d];
+              m.compliance(r, start + c) = g;
+            }
+      }
+    m.compliance_valid = true;
+    return m.compliance;
+  }
+
+  double ElasticBody::kinetic_energy() const { return impl->quadratic(impl->M, impl->v); }
+  double ElasticBody::elastic_energy() const { return impl->quadratic(impl->K, impl->u); }
+  double ElasticBody::load_power() const { return impl->p_load; }
+  double ElasticBody::contact_power() const { return impl->p_contact; }
+  double ElasticBody::damping_power() const { return impl->p_damping; }
+  double ElasticBody::load_work() const { return impl->w_load; }
+  double ElasticBody::contact_work() const { return impl->w_contact; }
+  double ElasticBody::damping_dissipation() const { return impl->w_damping; }
+
+  double ElasticBody::mean_bottom_displacement_y() const
+  {
+    double s = 0;
+    for (unsigned int i = 0; i < n_boundary_nodes(); ++i)
+      s += boundary_displacement(i)[1];
+    return s / n_boundary_nodes();
+  }
+
+  Eigen::Vector2d ElasticBody::displacement_at(const Eigen::Vector2d &x) const
+  {
+    Vector<double> value(2);
+    VectorTools::point_value(impl->dof, impl->u, Point<2>(x[0], x[1]), value);
+    return {value[0], value[1]};
+  }
+
+  Eigen::Vector2d ElasticBody::velocity_at(const Eigen::Vector2d &x) const
+  {
+    Vector<double> value(2);
+    VectorTools::point_value(impl->dof, impl->v, Point<2>(x[0], x[1]), value);
+    return {value[0], value[1]};
+  }
+
+  Eigen::Matrix2d ElasticBody::strain_at(const Eigen::Vector2d &x) const
+  {
+    std::vector<Tensor<1, 2>> grad(2);
+    VectorTools::point_gradient(impl->dof, impl->u, Point<2>(x[0], x[1]), grad);
+    Eigen::Matrix2d eps;
+    for (unsigned int a = 0; a < 2; ++a)
+      for (unsigned int b = 0; b < 2; ++b)
+        eps(a, b) = 0.5 * (grad[a][b] + grad[b][a]);
+    return eps;
+  }
+
+  void ElasticBody::static_solve()
+  {
+    Impl                     &m = *impl;
+    AffineConstraints<double> c;
+    m.make_constraints(c, true);
+    DynamicSparsityPattern dsp(m.dof.n_dofs());
+    DoFTools::make_sparsity_pattern(m.dof, dsp, c, false);
+    SparsityPattern sp;
+    sp.copy_from(dsp);
+    SparseMatrix<double> Ks(sp);
+    Vector<double>       f(m.dof.n_dofs());
+    m.assemble(c, nullptr, Ks, f);
+    f *= m.prm.top_pressure;
+    SparseDirectUMFPACK direct;
+    direct.initialize(Ks);
+    direct.solve(f);
+    c.distribute(f);
+    m.u         = f;
+    m.v         = 0;
+    m.predicted = false;
+  }
+
+  void ElasticBody::write_vtu(const std::string &filename) const
+  {
+    const Impl &m = *impl;
+    const double nu = m.prm.poisson_ratio;
+    const unsigned int nc = m.tria.n_active_cells();
+    Vector<double> sxx(nc), syy(nc), sxy(nc), szz(nc), mises(nc);
+    const QGauss<2> quad(m.prm.degree + 1);
+    FEValues<2>     fv(m.fe, quad, update_gradients | update_JxW_values);
+    std::vector<SymmetricTensor<2, 2>> eps(quad.size());
+    const FEValuesExtractors::Vector   disp(0);
+    for (const auto &cell : m.dof.active_cell_iterators())
+      {
+        fv.reinit(cell);
+        fv[disp].get_function_symmetric_gradients(m.u, eps);
+        double area = 0, exx = 0, eyy = 0, exy = 0;
+        for (unsigned int q = 0; q < quad.size(); ++q)
+          {
+            area += fv.JxW(q);
+            exx += eps[q][0][0] * fv.JxW(q);
+            eyy += eps[q][1][1] * fv.JxW(q);
+            exy += eps[q][0][1] * fv.JxW(q);
+          }
+        const auto   k  = cell->active_cell_index();
+        const double tr = (exx + eyy) / area;
+        sxx[k]          = m.lambda * tr + 2 * m.mu * exx / area;
+        syy[k]          = m.lambda * tr + 2 * m.mu * eyy / area;
+        sxy[k]          = 2 * m.mu * exy / area;
+        szz[k]          = nu * (sxx[k] + syy[k]);
+        mises[k]        = std::sqrt(0.5 * (std::pow(sxx[k] - syy[k], 2) + std::pow(syy[k] - szz[k], 2) +
+                                    std::pow(szz[k] - sxx[k], 2)) + 3 * sxy[k] * sxy[k]);
+      }
+
+    DataOut<2> out;
+    out.attach_dof_handler(m.dof);
+    const std::vector<DataComponentInterpretation::DataComponentInterpretation> vector_field(
+      2, DataComponentInterpretation::component_is_part_of_vector);
+    out.add_data_vector(m.u, std::vector<std::string>(2, "displacement"), DataOut<2>::type_dof_data, vector_field);
+    out.add_data_vector(m.v, std::vector<std::string>(2, "velocity"), DataOut<2>::type_dof_data, vector_field);
+    out.add_data_vector(sxx, "sigma_xx", DataOut<2>::type_cell_data);
+    out.add_data_vector(syy, "sigma_yy", DataOut<2>::type_cell_data);
+    out.add_data_vector(sxy, "sigma_xy", DataOut<2>::type_cell_data);
+    out.add_data_vector(szz, "sigma_zz", DataOut<2>::type_cell_data);
+    out.add_data_vector(mises, "von_mises", DataOut<2>::type_cell_data);
+    out.build_patches(m.prm.degree);
+
+    const std::string tmp_name = filename + ".tmp";
+    {
+      std::ofstream file(tmp_name);
+      if (!file)
+        throw RunError("ElasticBody::write_vtu: cannot open " + tmp_name);
+      out.write_vtu(file);
+      if (!file)
+        throw RunError("ElasticBody::write_vtu: cannot write " + tmp_name);
+    }
+    if (std::rename(tmp_name.c_str(), filename.c_str()) != 0)
+      throw RunError("ElasticBody::write_vtu: cannot rename " + tmp_name + " to " + filename);
+  }
+} // namespace tribo::fem
