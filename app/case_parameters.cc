@@ -115,6 +115,26 @@ namespace tribo::app
     prm.declare_entry("Layer thickness", "0", Double(),
                       "Thickness of the profile layers, m (>= 0); 0: one mean diameter.");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
+    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem"),
+                      "rigid: a rough wall of discs with the mass of the first body (the paper's "
+                      "classical model); fem: a plane-strain elastic body of that thickness "
+                      "(deal.II), touched through half-disc elements (the paper's hybrid model).");
+    prm.declare_entry("Upper body Young's modulus", "1e11", Double(),
+                      "E of the fem upper body, Pa (> 0; paper: 1e11 and 3e9).");
+    prm.declare_entry("Upper body Poisson ratio", "0.33", Double(),
+                      "nu of the fem upper body (in (-1, 0.5); paper: 0.33).");
+    prm.declare_entry("Upper body cell size", "0", Double(),
+                      "Cell size of the fem upper body's mesh, m (>= 0); 0: the smallest grain "
+                      "diameter d(1-s), the paper's choice.");
+    prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
+                      "Degree p of the fem upper body's Q_p elements.");
+    prm.declare_entry("Upper body mass damping", "0", Double(),
+                      "Rayleigh coefficient a of C = a M + b K for the fem upper body, 1/s (>= 0).");
+    prm.declare_entry("Upper body stiffness damping", "0", Double(),
+                      "Rayleigh coefficient b of C = a M + b K for the fem upper body, s (>= 0).");
+    prm.declare_entry("Half-disc diameter", "0", Double(),
+                      "Diameter of the half-disc contact elements on the fem upper body, m (>= 0); "
+                      "0: the cell size (one per boundary edge, the paper's choice).");
     prm.leave_subsection();
   }
 
@@ -195,6 +215,15 @@ namespace tribo::app
         sc.profile_samples = f.get_integer(S + "Profile samples");
         sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");
         sc.seed = f.get_integer(S + "Seed");
+        sc.deformable_upper_body = f.get(S + "Upper body model") == "fem";
+        sc.upper_youngs_modulus = f.get_checked(S + "Upper body Young's modulus", positive, "a positive modulus in Pa");
+        sc.upper_poisson_ratio = f.get_checked(S + "Upper body Poisson ratio", [](double v) { return v > -1 && v < 0.5; },
+                                               "a Poisson ratio in (-1, 0.5)");
+        sc.upper_cell_size = f.get_checked(S + "Upper body cell size", non_negative, "a size >= 0 in m");
+        sc.upper_degree = f.get_integer(S + "Upper body element degree");
+        sc.upper_mass_damping = f.get_checked(S + "Upper body mass damping", non_negative, "a coefficient >= 0 in 1/s");
+        sc.upper_stiffness_damping = f.get_checked(S + "Upper body stiffness damping", non_negative, "a coefficient >= 0 in s");
+        sc.half_disc_diameter = f.get_checked(S + "Half-disc diameter", non_negative, "a diameter >= 0 in m");
       }
     return p;
   }

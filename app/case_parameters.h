@@ -42,6 +42,16 @@ namespace tribo::app
     unsigned int profile_samples;      ///< profile samples over the shearing phase
     double       layer_thickness;      ///< profile layer thickness, m (0: d)
     unsigned int seed;
+    /// The upper first body: a rigid rough wall (clump) or the deal.II body (fem/)
+    /// touched through half-disc elements (dem/boundary.h).
+    bool         deformable_upper_body = false;
+    double       upper_youngs_modulus;  ///< E, Pa (fem)
+    double       upper_poisson_ratio;   ///< nu (fem)
+    double       upper_cell_size;       ///< m (fem); 0: the smallest grain diameter d(1-s)
+    unsigned int upper_degree;          ///< Q_p element degree (fem)
+    double       upper_mass_damping;    ///< Rayleigh a, 1/s (fem)
+    double       upper_stiffness_damping; ///< Rayleigh b, s (fem)
+    double       half_disc_diameter;    ///< m (fem); 0: the cell size
   };
 
   struct CaseParameters

@@ -59,9 +59,10 @@ namespace tribo::app
     , target(layer_target)
   {}
 
-  void LayerProfiles::sample(double t, const dem::ParticleSystem &s, const dem::MoreauJean &mj, double h)
+  void LayerProfiles::sample(double t, const dem::ParticleSystem &s, const dem::MoreauJean &mj, double h,
+                             double upper_surface)
   {
-    const double y_l = s.bodies[lower].position.y() + inset, y_u = s.bodies[upper].position.y() - inset;
+    const double y_l = s.bodies[lower].position.y() + inset, y_u = upper_surface;
     const double H   = y_u - y_l;
     if (layers == 0)
       layers = std::max(1, int(std::lround(H / target)));
@@ -127,14 +128,17 @@ namespace tribo::app
           continue;
         const dem::Vec2 t(-c.normal.y(), c.normal.x());
         const dem::Vec2 f1 = (c.r.x() * c.normal + c.r.y() * t) / h; // on disc 1
-        const dem::Vec2 point_from0 = (s.discs[c.disc[0]].radius + 0.5 * c.gap) * c.normal;
-        for (int side = 0; side < 2; ++side)
+        // Lever arms from each disc centre to the contact point (middle of the gap).
+        const dem::Vec2 l0 = (s.discs[c.disc[0]].radius + 0.5 * c.gap) * c.normal;
+        const dem::Vec2 l1 = -(s.discs[c.disc[1]].radius + 0.5 * c.gap) * c.normal;
+        // Side 0 of a half-disc contact is the deformable first body, not a grain.
+        for (int side = c.on_boundary() ? 1 : 0; side < 2; ++side)
           {
             const unsigned int b = c.body[side];
             if (b == lower || b == upper)
               continue;
             const dem::Vec2 f  = side == 0 ? dem::Vec2(-f1) : f1;
-            const dem::Vec2 l  = side == 0 ? point_from0 : dem::Vec2(point_from0 - c.branch);
+            const dem::Vec2 l  = side == 0 ? l0 : l1;
             const double    yc = s.disc_centre(c.disc[side]).y();
             spread(yc, yc + l.y(), f, l);
           }

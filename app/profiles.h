@@ -2,8 +2,10 @@
 /// @file Profiles across the gap of a shear cell: layers parallel to the walls,
 /// sampled at chosen times and averaged over the samples of the steady state.
 ///
-/// The gap between the wall surfaces, from y_L + a to y_U - a (y_L, y_U the wall
-/// centre lines, a the mean wall-disc radius), is cut into n layers of equal
+/// The gap between the first bodies' surfaces, from y_L + a (y_L the lower wall's
+/// centre line, a the mean wall-disc radius) to the upper surface given by the scene
+/// (a rigid wall: its centre line - a; a deformable body: its bottom face minus the
+/// half-disc radius), is cut into n layers of equal
 /// thickness, n fixed at the first sample (about one mean diameter each).
 /// Per layer and sample:
 /// - vx: mean x-velocity of the free discs whose centre lies in the layer
@@ -34,12 +36,16 @@ namespace tribo::app
     /// Quantities per layer, in this order in every sample.
     static const std::vector<std::string> &quantity_names();
 
-    /// @p lower, @p upper: the wall bodies; @p wall_inset: a, m; @p layer_target:
-    /// wanted layer thickness, m.
+    /// @p lower, @p upper: the wall bodies (@p upper = no_body when the upper first
+    /// body is not a rigid body of the system); @p wall_inset: a, m (the lower wall's
+    /// surface is its centre line + a); @p layer_target: wanted layer thickness, m.
     LayerProfiles(unsigned int lower, unsigned int upper, double wall_inset, double layer_target);
+    static constexpr unsigned int no_body = ~0u;
 
-    /// Record one sample at time @p t from the state after a step of length @p h.
-    void sample(double t, const dem::ParticleSystem &system, const dem::MoreauJean &mj, double h);
+    /// Record one sample at time @p t from the state after a step of length @p h,
+    /// with the upper first body's surface at height @p upper_surface (m).
+    void sample(double t, const dem::ParticleSystem &system, const dem::MoreauJean &mj, double h,
+                double upper_surface);
 
     /// Mean over the samples with time >= @p t_start: one row per layer,
     /// columns: layer, y (layer centre above the lower wall surface, m), y_over_h

@@ -59,7 +59,7 @@ namespace tribo::app
     }
 
     void write_fields(FieldWriter &writer, double t, const dem::ParticleSystem &s,
-                      const dem::MoreauJean &mj, double h)
+                      const dem::MoreauJean &mj, double h, const Scene &scene)
     {
       DiscField discs;
       for (std::size_t d = 0; d < s.discs.size(); ++d)
@@ -90,6 +90,9 @@ namespace tribo::app
           contacts.gap.push_back(c.gap);
         }
       writer.write(t, discs, contacts);
+      // The scene's own fields, SERIES_NNNNN.vtu, indexed in SERIES.pvd.
+      for (const std::string &file : scene.write_fields(writer.directory(), writer.n_snapshots() - 1))
+        writer.index(file.substr(0, file.rfind('_')), t, file);
     }
   } // namespace
 
@@ -192,6 +195,7 @@ namespace tribo::app
     dem::NlgsParameters solver = p.solver;
     solver.gap_tolerance       = p.gap_tolerance * system.min_radius();
     dem::MoreauJean mj(p.theta, p.law, solver, distance);
+    scene->attach(mj);
     const unsigned long n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
     {
       std::ostringstream os;
@@ -205,7 +209,7 @@ namespace tribo::app
       columns.push_back(c);
     TimeSeries  stats(columns);
     FieldWriter fields((dir / "fields").string());
-    write_fields(fields, 0, system, mj, h);
+    write_fields(fields, 0, system, mj, h, *scene);
 
     std::string   status = "complete", failure;
     unsigned long step = 0, total_iterations = 0, non_converged = 0, max_iterations = 0;
@@ -250,7 +254,7 @@ namespace tribo::app
             if (step % p.statistics_interval == 0 || last)
               stats.add_row(last_row);
             if (p.field_interval > 0 && step % p.field_interval == 0 && !last)
-              write_fields(fields, t, system, mj, h);
+              write_fields(fields, t, system, mj, h, *scene);
             const auto now = std::chrono::steady_clock::now();
             if (std::chrono::duration<double>(now - last_flush).count() > 10)
               {
@@ -276,7 +280,7 @@ namespace tribo::app
           stats.add_row(last_row);
       }
     progress.finish();
-    write_fields(fields, t, system, mj, h);
+    write_fields(fields, t, system, mj, h, *scene);
 
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     summary.set("status", status);

@@ -20,6 +20,15 @@ namespace tribo::app
     virtual ~Scene() = default;
     /// Create the bodies.
     virtual void build(dem::ParticleSystem &system) = 0;
+    /// Couple bodies that are not rigid discs (a BoundaryBody) to the integrator;
+    /// called once, after build() and before the first step.
+    virtual void attach(dem::MoreauJean &) {}
+    /// Write the scene's own fields (e.g. a deformable body) for snapshot @p index at
+    /// time @p t into directory @p dir; returns the file names written (relative to dir).
+    virtual std::vector<std::string> write_fields(const std::string & /*dir*/, unsigned int /*index*/) const
+    {
+      return {};
+    }
     /// The time step to use (the case's, unless the scene derives it).
     virtual double time_step(const dem::ParticleSystem &) const { return prm.time_step; }
     /// Adjust loads before step @p step (e.g. a pressure ramp).

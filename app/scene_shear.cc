@@ -6,13 +6,25 @@
 // stands for. Before `Shear start` the layer compacts under P, with the upper
 // wall's speed capped (Compaction speed limit); a Shear start at or after the End
 // time gives a compaction-only run.
+//
+// With `Upper body model = fem` the upper first body is the deal.II plane-strain body
+// of fem/ (Fig. 3b of the paper): same thickness, density and period, the pressure P as
+// a traction on its top face (ramped the same way), held in x on its top face, touched
+// by the grains through half-disc elements on its bottom face. Its bottom face stands
+// where the rigid wall's disc centres would be, less half a wall disc plus half a
+// half-disc, so that both models start from the same layer.
 #include "app/profiles.h"
 #include "app/scene.h"
 #include "app/steady_state.h"
 #include "core/errors.h"
 
+#ifdef TRIBO_WITH_FEM
+#include "coupling/elastic_boundary.h"
+#endif
+
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 namespace tribo::app
@@ -50,15 +62,21 @@ namespace tribo::app
                        0.5 * draw_diameter(), k.density);
           }
 
-        upper = add_wall(s, d_max + 0.5 * pitch + (rows - 1) * dy + pitch);
-        auto &u = s.bodies[upper];
-        u.drive = {{dem::Drive::velocity, dem::Drive::force, dem::Drive::velocity}};
-        const double discs_mass = u.mass;
-        u.mass                  = k.density * k.upper_body_thickness * k.length;
-        u.inertia *= u.mass / discs_mass;
+        const double upper_y = d_max + 0.5 * pitch + (rows - 1) * dy + pitch;
+        if (k.deformable_upper_body)
+          build_deformable_upper_body(upper_y - 0.5 * lower_wall_diameter);
+        else
+          {
+            upper = add_wall(s, upper_y);
+            auto &u = s.bodies[upper];
+            u.drive = {{dem::Drive::velocity, dem::Drive::force, dem::Drive::velocity}};
+            const double discs_mass = u.mass;
+            u.mass                  = k.density * k.upper_body_thickness * k.length;
+            u.inertia *= u.mass / discs_mass;
+          }
 
         profiles = std::make_unique<LayerProfiles>(
-          lower, upper, 0.5 * mean_wall_diameter, k.layer_thickness > 0 ? k.layer_thickness : k.mean_diameter);
+          lower, upper, 0.5 * lower_wall_diameter, k.layer_thickness > 0 ? k.layer_thickness : k.mean_diameter);
         mean_grain_diameter = 0;
         for (const auto &d : s.discs)
           if (d.body != lower && d.body != upper)
@@ -70,20 +88,49 @@ namespace tribo::app
         const auto  &k    = prm.shear;
         const double t    = step * prm.time_step;
         const double ramp = k.ramp_time > 0 ? std::min(1.0, (t + prm.time_step) / k.ramp_time) : 1.0;
-        s.bodies[upper].load[1]      = -ramp * k.pressure * k.length;
+        normal_force                 = ramp * k.pressure * k.length;
         sliding                      = t >= k.shear_start;
         s.bodies[lower].velocity.x() = sliding ? k.sliding_velocity : 0.0;
+        if (upper == LayerProfiles::no_body)
+          return; // the deformable body ramps its own traction, with the same law
+        s.bodies[upper].load[1] = -normal_force;
         // Compaction: cap the upper wall's speed (numerical damping, compaction only).
         auto &vy = s.bodies[upper].velocity.y();
         if (t < k.shear_start && k.compaction_speed > 0)
           vy = std::clamp(vy, -k.compaction_speed, k.compaction_speed);
       }
 
+      void attach(dem::MoreauJean &mj) override
+      {
+#ifdef TRIBO_WITH_FEM
+        if (boundary)
+          mj.attach(*boundary, half_disc_diameter, {0, -1}, prm.shear.length);
+#else
+        (void)mj;
+#endif
+      }
+
+      std::vector<std::string> write_fields(const std::string &dir, unsigned int index) const override
+      {
+#ifdef TRIBO_WITH_FEM
+        if (elastic)
+          {
+            const std::string name = "upper_body_" + std::to_string(100000 + index).substr(1) + ".vtu";
+            elastic->write_vtu(dir + "/" + name);
+            return {name};
+          }
+#endif
+        (void)dir;
+        (void)index;
+        return {};
+      }
+
       std::vector<std::string> columns() const override
       {
         return {"mu", "normal_force", "lower_wall_normal_force", "upper_wall_y", "upper_wall_vy",
                 "gap", "power_lower_wall", "power_upper_wall", "power_dissipated",
-                "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction"};
+                "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction",
+                "elastic_energy_upper_body"};
       }
 
       std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
@@ -93,15 +140,17 @@ namespace tribo::app
         const double t     = steps_done * prm.time_step;
         const auto  &f     = mj.contact_force();
         const auto  &power = mj.external_power();
-        const double F     = -s.bodies[upper].load[1];
+        const double F     = normal_force;
         double       ke_tb = 0;
         for (std::size_t b = 0; b < s.bodies.size(); ++b)
           if (b != lower && b != upper)
             ke_tb += s.bodies[b].kinetic_energy();
-        const double gap = s.bodies[upper].position.y() - s.bodies[lower].position.y();
-        if (gap < mean_wall_diameter)
-          throw RunError("at t = " + to_text(t) + " s the upper wall is " + to_text(gap) +
-                         " m above the lower wall, less than a wall-disc diameter: it has passed "
+        const Upper  ub  = upper_state(s, power);
+        const double gap = ub.y - s.bodies[lower].position.y();
+        const double surface_gap = ub.surface - (s.bodies[lower].position.y() + 0.5 * lower_wall_diameter);
+        if (surface_gap < 0)
+          throw RunError("at t = " + to_text(t) + " s the upper first body is " + to_text(gap) +
+                         " m above the lower wall, its surface below the lower wall's: it has passed "
                          "through the layer (contacts missed when a body moves more than the "
                          "detection distance in one step). Use a smaller Simulation/Time step or "
                          "a larger Contact law/Detection distance.");
@@ -111,22 +160,23 @@ namespace tribo::app
         const double interval = (prm.end_time - k.shear_start) / k.profile_samples;
         if (interval > 0 && t >= k.shear_start + (profiles->n_samples() + 0.5) * interval - 0.5 * prm.time_step &&
             profiles->n_samples() < k.profile_samples)
-          profiles->sample(t, s, mj, prm.time_step);
+          profiles->sample(t, s, mj, prm.time_step, ub.surface);
 
         // mu > 0 when the layer resists the lower wall's sliding, whatever the sign of V.
         const double direction = k.sliding_velocity < 0 ? -1.0 : 1.0;
         return {F > 0 ? -direction * f[lower].x() / F : 0.0,
                 F,
                 -f[lower].y(),
-                s.bodies[upper].position.y(),
-                s.bodies[upper].velocity.y(),
+                ub.y,
+                ub.vy,
                 gap,
                 power[lower],
-                power[upper],
+                ub.power,
                 -r.power_contacts,
                 ke_tb,
-                s.bodies[upper].kinetic_energy(),
-                grain_area(s) / ((gap - mean_wall_diameter) * k.length)};
+                ub.kinetic_energy,
+                grain_area(s) / (surface_gap * k.length),
+                ub.elastic_energy};
       }
 
       void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
@@ -151,7 +201,7 @@ namespace tribo::app
         j.set("averaging_start", start);
         j.set("normal_force_mean", stat("lower_wall_normal_force").first);
         j.set("normal_force_target", k.pressure * k.length);
-        const double h_tb = stat("gap").first - mean_wall_diameter;
+        const double h_tb = stat("gap").first - (upper_y_to_surface + 0.5 * lower_wall_diameter);
         j.set("third_body_thickness", h_tb);
         j.set("solid_fraction_mean", stat("solid_fraction").first);
         j.set("cohesion_number", prm.law.cohesion / (k.pressure * mean_grain_diameter));
@@ -195,6 +245,71 @@ namespace tribo::app
       }
 
     private:
+      /// What the statistics need from the upper first body, whatever its model.
+      struct Upper
+      {
+        double y, vy;          ///< wall centre line (rigid) or mean bottom face (fem), m and m/s
+        double surface;        ///< the surface the grains touch, m
+        double power;          ///< power of its external load over the step, W/m
+        double kinetic_energy; ///< J/m
+        double elastic_energy; ///< J/m (0 for the rigid wall)
+      };
+
+      Upper upper_state(const dem::ParticleSystem &s, const std::vector<double> &power) const
+      {
+        if (upper != LayerProfiles::no_body)
+          {
+            const auto &b = s.bodies[upper];
+            return {b.position.y(), b.velocity.y(), b.position.y() - upper_y_to_surface, power[upper],
+                    b.kinetic_energy(), 0.0};
+          }
+#ifdef TRIBO_WITH_FEM
+        const unsigned int n = elastic->n_boundary_nodes();
+        double             vy = 0;
+        for (unsigned int i = 0; i < n; ++i)
+          vy += elastic->boundary_velocity(i).y() / n;
+        const double y = elastic->parameters().bottom + elastic->mean_bottom_displacement_y();
+        return {y, vy, y - upper_y_to_surface, elastic->load_power(), elastic->kinetic_energy(),
+                elastic->elastic_energy()};
+#else
+        return {};
+#endif
+      }
+
+      /// The deal.II upper body with its bottom face at @p bottom (m).
+      void build_deformable_upper_body(double bottom)
+      {
+#ifdef TRIBO_WITH_FEM
+        const auto  &k    = prm.shear;
+        const double cell = k.upper_cell_size > 0 ? k.upper_cell_size : k.mean_diameter * (1 - k.diameter_spread);
+        fem::ElasticBodyParameters e;
+        e.length             = k.length;
+        e.thickness          = k.upper_body_thickness;
+        e.youngs_modulus     = k.upper_youngs_modulus;
+        e.poisson_ratio      = k.upper_poisson_ratio;
+        e.density            = k.density;
+        e.cells_x            = std::max(1L, std::lround(k.length / cell));
+        e.cells_y            = std::max(1L, std::lround(k.upper_body_thickness / cell));
+        e.degree             = k.upper_degree;
+        e.rayleigh_mass      = k.upper_mass_damping;
+        e.rayleigh_stiffness = k.upper_stiffness_damping;
+        e.theta              = prm.theta;
+        e.time_step          = prm.time_step;
+        e.top_pressure       = k.pressure;
+        e.pressure_ramp_time = k.ramp_time;
+        e.top_fixed_in_x     = true;
+        half_disc_diameter   = k.half_disc_diameter > 0 ? k.half_disc_diameter : k.length / e.cells_x;
+        e.bottom             = bottom + 0.5 * half_disc_diameter;
+        upper_y_to_surface   = 0.5 * half_disc_diameter;
+        elastic              = std::make_unique<fem::ElasticBody>(e);
+        boundary             = std::make_unique<coupling::ElasticBoundary>(*elastic);
+#else
+        (void)bottom;
+        throw InputError("Shear cell/Upper body model = fem needs the deformable body module, "
+                         "which this build left out (TRIBO_WITH_FEM=OFF)");
+#endif
+      }
+
       double draw_diameter()
       {
         const auto &k = prm.shear;
@@ -202,7 +317,8 @@ namespace tribo::app
         return k.mean_diameter * u(rng);
       }
 
-      /// A rough wall: discs of drawn sizes spread evenly along the period at height y.
+      /// A rough wall: discs of drawn sizes spread evenly along the period at height y;
+      /// its mean disc diameter goes to lower_wall_diameter (both walls draw alike).
       unsigned int add_wall(dem::ParticleSystem &s, double y)
       {
         const auto        &k = prm.shear;
@@ -214,8 +330,12 @@ namespace tribo::app
           {
             radii[i]   = 0.5 * draw_diameter();
             centres[i] = {(i + 0.5) * k.length / n, y};
-            mean_wall_diameter += radii[i] / n; // two walls: mean of their diameters
           }
+        const double mean_diameter = 2 * std::accumulate(radii.begin(), radii.end(), 0.0) / n;
+        if (s.bodies.empty())
+          lower_wall_diameter = mean_diameter;
+        else
+          upper_y_to_surface = 0.5 * mean_diameter;
         return s.add_clump(centres, radii, k.density);
       }
 
@@ -229,10 +349,19 @@ namespace tribo::app
       }
 
       std::mt19937                   rng;
-      unsigned int                   lower = 0, upper = 0;
+      unsigned int                   lower = 0, upper = LayerProfiles::no_body;
       unsigned long                  steps_done = 0;
       bool                           sliding    = false; ///< the lower wall has started sliding
-      double                         mean_wall_diameter = 0, mean_grain_diameter = 0;
+      double                         normal_force = 0;   ///< P L at the current ramp, N/m
+      double                         lower_wall_diameter = 0, mean_grain_diameter = 0;
+      /// From the upper body's reference height (ub.y) down to the surface the grains
+      /// touch: the upper wall's mean disc radius, or the half-disc radius.
+      double                         upper_y_to_surface = 0;
+      double                         half_disc_diameter = 0;
+#ifdef TRIBO_WITH_FEM
+      std::unique_ptr<fem::ElasticBody>          elastic;
+      std::unique_ptr<coupling::ElasticBoundary> boundary;
+#endif
       std::unique_ptr<LayerProfiles> profiles;
       SteadyState                    steady;
     };

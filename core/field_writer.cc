@@ -123,4 +123,11 @@ namespace tribo
     atomic_write(dir + "/discs.pvd", pvd_text(disc_files));
     atomic_write(dir + "/contacts.pvd", pvd_text(contact_files));
   }
+
+  void FieldWriter::index(const std::string &series, double t, const std::string &file)
+  {
+    auto &files = series_files[series];
+    files.emplace_back(t, file);
+    atomic_write(dir + "/" + series + ".pvd", pvd_text(files));
+  }
 } // namespace tribo

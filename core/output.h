@@ -95,11 +95,16 @@ namespace tribo
     /// Write discs_NNNNN.vtu and contacts_NNNNN.vtu for time @p t and rewrite
     /// discs.pvd and contacts.pvd.
     void write(double t, const DiscField &discs, const ContactField &contacts);
+    /// Add @p file (already written in the directory) at time @p t to the index
+    /// SERIES.pvd, e.g. the snapshots of a deformable body next to the discs.
+    void index(const std::string &series, double t, const std::string &file);
     unsigned int n_snapshots() const { return static_cast<unsigned int>(times.size()); }
+    const std::string &directory() const { return dir; }
 
   private:
     std::string                                 dir;
     std::vector<std::pair<double, std::string>> disc_files, contact_files;
+    std::map<std::string, std::vector<std::pair<double, std::string>>> series_files;
     std::vector<double>                         times;
   };
 } // namespace tribo
