@@ -135,6 +135,12 @@ namespace tribo::app
     prm.declare_entry("Half-disc diameter", "0", Double(),
                       "Diameter of the half-disc contact elements on the fem upper body, m (>= 0); "
                       "0: the cell size (one per boundary edge, the paper's choice).");
+    prm.declare_entry("Upper body compaction damping", "1", Double(),
+                      "Damping ratio zeta (>= 0) of the fem upper body's first thickness mode, "
+                      "omega_1 = pi c_p / (2 H), added before Shear start as stiffness-proportional "
+                      "damping b_c = 2 zeta / omega_1 and removed when shearing starts: the body lands "
+                      "on the layer at about 1 m/s and would otherwise ring (no numerical damping at "
+                      "theta = 0.5). The rigid wall's Compaction speed limit plays this part. 0: off.");
     prm.leave_subsection();
   }
 
@@ -224,6 +230,7 @@ namespace tribo::app
         sc.upper_mass_damping = f.get_checked(S + "Upper body mass damping", non_negative, "a coefficient >= 0 in 1/s");
         sc.upper_stiffness_damping = f.get_checked(S + "Upper body stiffness damping", non_negative, "a coefficient >= 0 in s");
         sc.half_disc_diameter = f.get_checked(S + "Half-disc diameter", non_negative, "a diameter >= 0 in m");
+        sc.upper_compaction_damping = f.get_checked(S + "Upper body compaction damping", non_negative, "a damping ratio >= 0");
       }
     return p;
   }

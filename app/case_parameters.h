@@ -52,6 +52,9 @@ namespace tribo::app
     double       upper_mass_damping;    ///< Rayleigh a, 1/s (fem)
     double       upper_stiffness_damping; ///< Rayleigh b, s (fem)
     double       half_disc_diameter;    ///< m (fem); 0: the cell size
+    /// Damping ratio zeta of the first thickness mode added before Shear start (fem),
+    /// as stiffness-proportional damping b_c = 2 zeta / omega_1.
+    double       upper_compaction_damping;
   };
 
   struct CaseParameters

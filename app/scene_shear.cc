@@ -92,7 +92,15 @@ namespace tribo::app
         sliding                      = t >= k.shear_start;
         s.bodies[lower].velocity.x() = sliding ? k.sliding_velocity : 0.0;
         if (upper == LayerProfiles::no_body)
-          return; // the deformable body ramps its own traction, with the same law
+          {
+#ifdef TRIBO_WITH_FEM
+            // The body ramps its own traction, with the same law; the compaction
+            // damping goes when shearing starts.
+            if (sliding)
+              elastic->set_damping(k.upper_mass_damping, k.upper_stiffness_damping);
+#endif
+            return;
+          }
         s.bodies[upper].load[1] = -normal_force;
         // Compaction: cap the upper wall's speed (numerical damping, compaction only).
         auto &vy = s.bodies[upper].velocity.y();
@@ -130,7 +138,7 @@ namespace tribo::app
         return {"mu", "normal_force", "lower_wall_normal_force", "upper_wall_y", "upper_wall_vy",
                 "gap", "power_lower_wall", "power_upper_wall", "power_dissipated",
                 "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction",
-                "elastic_energy_upper_body"};
+                "elastic_energy_upper_body", "power_damping_upper_body"};
       }
 
       std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
@@ -176,7 +184,8 @@ namespace tribo::app
                 ke_tb,
                 ub.kinetic_energy,
                 grain_area(s) / (surface_gap * k.length),
-                ub.elastic_energy};
+                ub.elastic_energy,
+                r.boundary_dissipation};
       }
 
       void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
@@ -301,6 +310,13 @@ namespace tribo::app
         half_disc_diameter   = k.half_disc_diameter > 0 ? k.half_disc_diameter : k.length / e.cells_x;
         e.bottom             = bottom + 0.5 * half_disc_diameter;
         upper_y_to_surface   = 0.5 * half_disc_diameter;
+        if (k.shear_start > 0 && k.upper_compaction_damping > 0)
+          {
+            // Before Shear start: b + 2 zeta / omega_1, omega_1 = pi c_p / (2 H).
+            const double nu = e.poisson_ratio, E = e.youngs_modulus;
+            const double c_p = std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu) * e.density));
+            e.rayleigh_stiffness += 2 * k.upper_compaction_damping / (M_PI * c_p / (2 * e.thickness));
+          }
         elastic              = std::make_unique<fem::ElasticBody>(e);
         boundary             = std::make_unique<coupling::ElasticBoundary>(*elastic);
 #else

@@ -438,6 +438,19 @@ namespace tribo::fem
   double ElasticBody::time() const { return impl->t; }
   double ElasticBody::time_step() const { return impl->h; }
 
+  void ElasticBody::set_damping(double a, double b)
+  {
+    if (!(a >= 0) || !(b >= 0))
+      throw InputError("ElasticBody: Rayleigh coefficients must be >= 0, not a = " + to_text(a) +
+                       ", b = " + to_text(b));
+    if (a == impl->prm.rayleigh_mass && b == impl->prm.rayleigh_stiffness)
+      return;
+    impl->prm.rayleigh_mass      = a;
+    impl->prm.rayleigh_stiffness = b;
+    impl->factorize();
+    impl->predicted = false;
+  }
+
   double ElasticBody::pressure(double t) const
   {
     const auto &p = impl->prm;

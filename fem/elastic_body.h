@@ -109,6 +109,11 @@ namespace tribo::fem
     /// the free velocity (call predict() again). Throws tribo::InputError for h <= 0.
     void set_time_step(double h);
 
+    /// Change the Rayleigh coefficients a (1/s) and b (s) of C = a M + b K; only if they
+    /// change: refactorises Mt and drops the cached compliance and free velocity.
+    /// Throws tribo::InputError for negative values.
+    void set_damping(double a, double b);
+
     /// Compute and keep the free velocity v_free of the step [t, t + h] (no impulse).
     void predict();
     /// Complete the step with nodal impulses (N s/m, on the body, one per bottom node,

@@ -1,5 +1,6 @@
 // The deal.II elastic body (fem/elastic_body.h) against closed forms and against an
 // independent dense Q1 model assembled here by hand.
+#include "core/errors.h"
 #include "fem/elastic_body.h"
 
 #include <Eigen/Dense>
@@ -352,6 +353,20 @@ TEST(Fem, SetTimeStepRefactorises)
   EXPECT_GT(relative_difference(G0, fresh.boundary_compliance()), 1e-3);
   EXPECT_LT(relative_difference(body.boundary_compliance(), fresh.boundary_compliance()), 1e-12);
   EXPECT_LT(relative_difference(body.boundary_compliance(), dense_inverse_iteration_matrix(p).topLeftCorner(8, 8)), 1e-10);
+}
+
+TEST(Fem, SetDampingRefactorises)
+{
+  auto        p = small_body(4, 3);
+  ElasticBody body(p);
+  const Eigen::MatrixXd G0 = body.boundary_compliance();
+  body.set_damping(3e8, 2e-9);
+  p.rayleigh_mass      = 3e8;
+  p.rayleigh_stiffness = 2e-9;
+  const ElasticBody fresh(p);
+  EXPECT_GT(relative_difference(G0, fresh.boundary_compliance()), 1e-3);
+  EXPECT_LT(relative_difference(body.boundary_compliance(), fresh.boundary_compliance()), 1e-12);
+  EXPECT_THROW(body.set_damping(-1, 0), tribo::InputError);
 }
 
 TEST(Fem, WritesVtuWithStressFields)

@@ -1,0 +1,134 @@
+#!/usr/bin/python3
+"""The shear cell with a deformable (deal.II) upper body, on the scaled-down sample of
+test_shear_physics.py (120 discs, 13 us of shear, tolerance 1e-3):
+
+- energy: every step but the one where the lower wall starts sliding, the kinetic
+  energy of the rigid bodies plus the upper body's kinetic and elastic energy change by
+  h (power_external + power_contacts - power_damping_upper_body), the damping being the
+  compaction damping, gone after Shear start;
+- equilibrium: the mean normal force on the lower wall is P L, and the time-averaged
+  sigma_yy profile is flat at P away from the first bodies;
+- the stiff limit: a body 1e6 times stiffer than steel, with half-discs as large as the
+  rigid wall's discs (the same roughness), gives the rigid wall's friction and a
+  velocity profile that ends near 0 at the upper body, as the rigid wall does;
+- the VTU of the body: its mean sigma_yy over the run's snapshots is near -P.
+
+Usage: test_shear_fem.py PATH/TO/tribo
+"""
+import concurrent.futures
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, "..", "cli"))
+import test_shear_physics as base  # noqa: E402  (the case text)
+import tribo_cli  # noqa: E402  (VTU and PVD readers)
+
+TRIBO = None
+P, L, V, H = base.P, base.L, base.V, 2e-9
+COMMON = ["--set", "Solver/Tolerance=1e-3"]
+FEM = ["--set", "Shear cell/Upper body model=fem"]
+
+
+def run(directory, name, extra):
+    case = os.path.join(directory, "case.prm")
+    if not os.path.exists(case):
+        with open(case, "w") as f:
+            f.write(base.CASE)
+    out = os.path.join(directory, name)
+    subprocess.run([TRIBO, "run", case, "--output", out, "--quiet"] + COMMON + extra,
+                   check=True, timeout=300)
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    stats = np.genfromtxt(os.path.join(out, "statistics.csv"), delimiter=",", names=True)
+    profiles = np.genfromtxt(os.path.join(out, "profiles.csv"), delimiter=",", names=True)
+    return out, summary["results"], stats, profiles
+
+
+class DeformableUpperBody(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        with concurrent.futures.ThreadPoolExecutor(2) as pool:
+            steel = pool.submit(run, cls.tmp.name, "steel", FEM + ["--set", "Output/Field interval=1000"])
+            stiff = pool.submit(run, cls.tmp.name, "stiff",
+                                FEM + ["--set", "Shear cell/Upper body Young's modulus=1e17",
+                                       "--set", "Shear cell/Half-disc diameter=1.2e-6"])
+            rigid = pool.submit(run, cls.tmp.name, "rigid", [])
+            cls.steel, cls.stiff, cls.rigid = steel.result(), stiff.result(), rigid.result()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_energy_balance_every_step(self):
+        _, r, st, _ = self.steel
+        energy = st["kinetic_energy"] + st["kinetic_energy_upper_wall"] + st["elastic_energy_upper_body"]
+        self.assertGreater(st["elastic_energy_upper_body"].max(), 0)
+        change = np.diff(energy)
+        work = H * (st["power_external"] + st["power_contacts"] - st["power_damping_upper_body"])[1:]
+        self.assertGreater(st["power_damping_upper_body"][st["time"] < 3e-6].max(), 0)  # compaction damping
+        self.assertEqual(st["power_damping_upper_body"][st["time"] > 3e-6 + H].max(), 0)  # then none
+        # The lower wall's velocity is set to V between two steps: that step is excluded.
+        start = np.argmin(np.abs(st["time"] - (3e-6 + H)))
+        keep = np.ones(len(change), bool)
+        keep[start - 1] = False
+        np.testing.assert_allclose(change[keep], work[keep], rtol=0, atol=1e-9 * np.abs(energy).max())
+        self.assertGreater(np.abs(change[~keep]).max(), 1e-6 * np.abs(energy).max())  # the jump is real
+
+    def test_equilibrium(self):
+        for out, r, st, p in (self.steel, self.stiff):
+            self.assertAlmostEqual(r["normal_force_mean"] / (P * L), 1.0, delta=0.01)
+            interior = p["sigma_yy"][2:-2]
+            np.testing.assert_allclose(interior, P, rtol=0.03)
+            self.assertAlmostEqual(r["power_balance_ratio"], 1.0, delta=0.05)
+
+    def test_stiff_body_reproduces_the_rigid_wall(self):
+        _, rs, _, ps = self.stiff
+        _, rr, _, pr = self.rigid
+        self.assertAlmostEqual(rs["mu_mean"] / rr["mu_mean"], 1.0, delta=0.15)
+        for p in (ps, pr):
+            self.assertGreater(p["vx"][0], 0.7 * V)
+            self.assertLess(p["vx"][-1], 0.3 * V)
+
+    def test_body_fields(self):
+        out = self.steel[0]
+        pvd = tribo_cli.read_pvd(os.path.join(out, "fields", "upper_body.pvd"))
+        self.assertGreaterEqual(len(pvd), 8)
+        mean_syy = []
+        for t, name in pvd[1:]:
+            data = tribo_cli.read_vtu_with_vtk(self, os.path.join(out, "fields", name))
+            for field in ("displacement", "velocity", "sigma_xx", "sigma_yy", "sigma_xy", "von_mises"):
+                self.assertIn(field, data["point_data"])
+            mean_syy.append(data["point_data"]["sigma_yy"].mean())
+        # The body vibrates (no damping while shearing): the mean over snapshots.
+        self.assertAlmostEqual(np.mean(mean_syy) / -P, 1.0, delta=0.25)
+
+
+class BadInput(unittest.TestCase):
+    def test_poisson_ratio_of_one_half_is_refused(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            case = os.path.join(tmp, "case.prm")
+            with open(case, "w") as f:
+                f.write(base.CASE.replace("  set Number of discs = 120",
+                                          "  set Number of discs = 120\n  set Upper body model = fem\n"
+                                          "  set Upper body Poisson ratio = 0.5"))
+            p = subprocess.run([TRIBO, "check", case], capture_output=True, text=True, timeout=60)
+            self.assertEqual(p.returncode, 2)
+            self.assertIn("Upper body Poisson ratio", p.stderr)
+            self.assertIn("a Poisson ratio in (-1, 0.5)", p.stderr)
+            self.assertIn("case.prm:", p.stderr)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit("usage: test_shear_fem.py PATH/TO/tribo")
+    TRIBO = os.path.abspath(sys.argv.pop(1))
+    unittest.main(verbosity=2)
