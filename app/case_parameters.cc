@@ -106,7 +106,8 @@ namespace tribo::app
     prm.declare_entry("Compaction speed limit", "1", Double(),
                       "Before Shear start, the upper wall's vertical speed is capped at this value, m/s "
                       "(>= 0; 0: no cap), so that the compaction stroke under P cannot hit the grains "
-                      "at tens of m/s and tunnel into the layer. Not applied while shearing.");
+                      "at tens of m/s and tunnel into the layer. Not applied while shearing, nor to a fem "
+                      "upper body (see Upper body compaction damping).");
     prm.declare_entry("Upper body thickness", "1.5e-4", Double(),
                       "Thickness of the first body the upper wall stands for, m (> 0; paper: 1.5e-4): "
                       "its mass is density * thickness * L.");

@@ -299,6 +299,10 @@ namespace tribo::app
         e.density            = k.density;
         e.cells_x            = std::max(1L, std::lround(k.length / cell));
         e.cells_y            = std::max(1L, std::lround(k.upper_body_thickness / cell));
+        if (double(e.cells_x) * e.cells_y > 4e6)
+          throw InputError("entry 'Shear cell/Upper body cell size' = '" + to_text(k.upper_cell_size) +
+                           "': expected a cell size giving at most 4e6 cells; " + to_text(cell) +
+                           " m gives " + to_text(double(e.cells_x) * e.cells_y) + " cells");
         e.degree             = k.upper_degree;
         e.rayleigh_mass      = k.upper_mass_damping;
         e.rayleigh_stiffness = k.upper_stiffness_damping;

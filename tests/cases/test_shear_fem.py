@@ -126,6 +126,19 @@ class BadInput(unittest.TestCase):
             self.assertIn("a Poisson ratio in (-1, 0.5)", p.stderr)
             self.assertIn("case.prm:", p.stderr)
 
+    def test_a_mesh_too_fine_is_refused(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            case = os.path.join(tmp, "case.prm")
+            with open(case, "w") as f:
+                f.write(base.CASE)
+            p = subprocess.run([TRIBO, "run", case, "--output", os.path.join(tmp, "out"), "--quiet",
+                                "--set", "Shear cell/Upper body model=fem",
+                                "--set", "Shear cell/Upper body cell size=1e-9"],
+                               capture_output=True, text=True, timeout=60)
+            self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+            self.assertIn("'Shear cell/Upper body cell size' = '1e-09'", p.stderr)
+            self.assertIn("at most 4e6 cells", p.stderr)
+
 
 if __name__ == "__main__":
     if len(sys.argv) < 2:
