@@ -68,6 +68,12 @@ namespace tribo::app
     prm.declare_entry("Statistics interval", "1", Integer(1), "Steps between rows of statistics.csv, >= 1.");
     prm.declare_entry("Field interval", "0", Integer(0),
                       "Steps between VTU snapshots in fields/; 0 writes only the first and the last.");
+    prm.declare_entry("Checkpoint interval", "600", Double(0),
+                      "Wall-clock seconds between checkpoints (checkpoint.bin in the output directory, "
+                      "for `tribo run CASE.prm --resume DIR`); 0: none on a timer. An interrupted run "
+                      "(SIGINT, SIGTERM) also writes one.");
+    prm.declare_entry("Checkpoint step interval", "0", Integer(0),
+                      "Steps between checkpoints, in addition to the timer; 0: none.");
     prm.declare_entry("Plots", "true", Bool(),
                       "Write PNG plots (mu.png, power.png, profiles.png) of a shear run with "
                       "scripts/plot_run.py (Debian's python3-matplotlib).");
@@ -181,6 +187,8 @@ namespace tribo::app
     p.statistics_interval = f.get_integer("Output/Statistics interval");
     p.field_interval      = f.get_integer("Output/Field interval");
     p.plots               = f.get_bool("Output/Plots");
+    p.checkpoint_interval      = f.get_double("Output/Checkpoint interval");
+    p.checkpoint_step_interval = f.get_integer("Output/Checkpoint step interval");
 
     auto &c = p.collision;
     if (p.scene == "collision")

@@ -70,6 +70,8 @@ namespace tribo::app
     unsigned int statistics_interval; ///< steps between rows of statistics.csv
     unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)
     bool         plots;               ///< PNG plots of a shear run (scripts/plot_run.py)
+    double       checkpoint_interval;      ///< wall-clock seconds between checkpoints (0: none)
+    unsigned int checkpoint_step_interval; ///< steps between checkpoints (0: none)
     CollisionParameters  collision;
     ShearCellParameters  shear;
   };

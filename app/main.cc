@@ -17,6 +17,9 @@ namespace
 Usage:
   tribo run CASE.prm [--output DIR] [--set "Subsection/Entry=value" ...] [--quiet]
       Run a case; outputs go to DIR (default output/<case name>), see docs/outputs.md.
+  tribo run CASE.prm --resume DIR [--set ...] [--quiet]
+      Continue the run in DIR from its checkpoint.bin (Output/Checkpoint interval); only
+      Solver/*, Output/* and Simulation/End time may differ from the checkpointed run.
   tribo check CASE.prm [--set ...]
       Read and validate a case without running it.
   tribo study STUDY.prm [--output DIR] [--quiet]
@@ -85,11 +88,11 @@ int main(int argc, char **argv)
       for (std::size_t i = 1; i < args.size(); ++i)
         {
           const std::string &a = args[i];
-          if (a == "--output" || a == "--set")
+          if (a == "--output" || a == "--set" || a == "--resume")
             {
               if (i + 1 >= args.size())
                 usage_error(a + " needs a value");
-              (a == "--output" ? o.output_dir : o.overrides.emplace_back()) = args[++i];
+              (a == "--output" ? o.output_dir : a == "--resume" ? o.resume_dir : o.overrides.emplace_back()) = args[++i];
             }
           else if (a == "--quiet")
             o.quiet = true;

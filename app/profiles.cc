@@ -1,5 +1,9 @@
 #include "app/profiles.h"
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/vector.hpp>
+
 #include <algorithm>
 #include <cmath>
 
@@ -178,5 +182,14 @@ namespace tribo::app
         out.push_back(r);
       }
     return out;
+  }
+  void LayerProfiles::save(CheckpointOut &ar) const
+  {
+    ar << layers << times << gap << data;
+  }
+
+  void LayerProfiles::load(CheckpointIn &ar)
+  {
+    ar >> layers >> times >> gap >> data;
   }
 } // namespace tribo::app

@@ -22,6 +22,7 @@
 ///   sigma_yy = P. Compression positive, Pa. sigma_xy: x-force per unit length
 ///   transmitted across a horizontal plane.
 
+#include "core/checkpoint.h"
 #include "dem/moreau_jean.h"
 #include "dem/particle_system.h"
 
@@ -56,6 +57,9 @@ namespace tribo::app
     unsigned int n_layers() const { return layers; }
     unsigned int n_samples() const { return times.size(); }
     unsigned int n_samples_after(double t_start) const;
+    /// Checkpoint: the samples taken so far.
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
 
   private:
     unsigned int lower, upper;

@@ -2,6 +2,7 @@
 
 #include "app/case_parameters.h"
 #include "app/scene.h"
+#include "core/checkpoint.h"
 #include "core/errors.h"
 #include "core/output.h"
 #include "core/parameter_file.h"
@@ -9,6 +10,10 @@
 
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/map.hpp>
+#include <boost/serialization/string.hpp>
 
 #include <cctype>
 #include <cstdlib>
@@ -94,7 +99,50 @@ namespace tribo::app
       for (const std::string &file : scene.write_fields(writer.directory(), writer.n_snapshots() - 1))
         writer.index(file.substr(0, file.rfind('_')), t, file);
     }
+    /// What a resumed run may change: how it solves and what it writes, and how long it
+    /// runs. Anything else (the scene, the law, the loading) would not continue the same
+    /// run.
+    bool may_change_on_resume(const std::string &entry)
+    {
+      return entry.rfind("Solver/", 0) == 0 || entry.rfind("Output/", 0) == 0 ||
+             entry == "Simulation/End time";
+    }
+
+    /// The entries that differ between the checkpoint's parameters and the case's, as a
+    /// log text; an InputError for one that may not change.
+    std::string changed_entries(const std::map<std::string, std::string> &saved,
+                                const std::map<std::string, std::string> &now, const std::string &dir)
+    {
+      std::string changes;
+      for (const auto &[entry, value] : now)
+        {
+          const auto it = saved.find(entry);
+          const std::string before = it == saved.end() ? "(absent)" : it->second;
+          if (before == value)
+            continue;
+          if (!may_change_on_resume(entry))
+            throw InputError("--resume " + dir + ": entry '" + entry + "' is '" + value +
+                             "' in the case but '" + before + "' in the checkpoint; a resumed run "
+                             "may change only Solver/*, Output/* and Simulation/End time");
+          changes += (changes.empty() ? "; changed: " : ", ") + entry + " " + before + " -> " + value;
+        }
+      return changes;
+    }
   } // namespace
+
+  std::string run_status(const std::string &dir)
+  {
+    try
+      {
+        boost::property_tree::ptree tree;
+        boost::property_tree::read_json((fs::path(dir) / "summary.json").string(), tree);
+        return tree.get<std::string>("status", "");
+      }
+    catch (const std::exception &)
+      {
+        return "";
+      }
+  }
 
   std::string parameter_reference()
   {
@@ -141,24 +189,58 @@ namespace tribo::app
         return exit_ok;
       }
 
-    // The output directory, emptied of a previous run's files.
-    const fs::path dir = o.output_dir.empty() ? fs::path("output") / fs::path(o.case_file).stem()
-                                              : fs::path(o.output_dir);
-    try
-      {
-        fs::create_directories(dir / "fields");
-        for (const char *name : {"statistics.csv", "results.h5", "summary.json", "log.txt",
-                                 "original.prm", "parameters.prm", "profiles.csv", "mu.png",
-                                 "power.png", "profiles.png"})
-          fs::remove(dir / name);
-        for (const auto &entry : fs::directory_iterator(dir / "fields"))
-          fs::remove(entry.path());
-      }
-    catch (const fs::filesystem_error &e)
-      {
-        throw InputError("--output " + dir.string() + ": cannot prepare the directory (" +
-                         e.code().message() + ")");
-      }
+    // The output directory: emptied of a previous run's files, or the one being resumed.
+    const bool resuming = !o.resume_dir.empty();
+    if (resuming && !o.output_dir.empty() && fs::path(o.output_dir) != fs::path(o.resume_dir))
+      throw InputError("--output " + o.output_dir + " and --resume " + o.resume_dir +
+                       " name different directories: a resumed run writes where it started");
+    const fs::path dir = resuming ? fs::path(o.resume_dir)
+                         : o.output_dir.empty() ? fs::path("output") / fs::path(o.case_file).stem()
+                                                : fs::path(o.output_dir);
+    const fs::path checkpoint_file = dir / "checkpoint.bin";
+    if (resuming && !fs::exists(checkpoint_file))
+      throw InputError("--resume " + dir.string() + ": no checkpoint.bin there" +
+                       (run_status(dir.string()) == "complete"
+                          ? std::string(" (the run is complete: nothing to resume)")
+                          : std::string(" (none was written: Output/Checkpoint interval and "
+                                        "Checkpoint step interval were 0, or the run stopped "
+                                        "before the first one)")));
+    std::map<std::string, std::string> resolved;
+    {
+      std::ostringstream os;
+      prm.print_parameters(os, dealii::ParameterHandler::JSON);
+      boost::property_tree::ptree tree;
+      std::istringstream          is(os.str());
+      boost::property_tree::read_json(is, tree);
+      collect(tree, "", resolved);
+    }
+    // A resumption is checked before anything is written: a refused one changes nothing.
+    std::string changes;
+    if (resuming)
+      read_checkpoint(
+        checkpoint_file.string(),
+        [&](CheckpointIn &ar) {
+          std::map<std::string, std::string> saved;
+          ar >> saved;
+          changes = changed_entries(saved, resolved, o.resume_dir);
+        },
+        false);
+    if (!resuming)
+      try
+        {
+          fs::create_directories(dir / "fields");
+          for (const char *name : {"statistics.csv", "results.h5", "summary.json", "log.txt",
+                                   "original.prm", "parameters.prm", "profiles.csv", "mu.png",
+                                   "power.png", "profiles.png", "checkpoint.bin"})
+            fs::remove(dir / name);
+          for (const auto &entry : fs::directory_iterator(dir / "fields"))
+            fs::remove(entry.path());
+        }
+      catch (const fs::filesystem_error &e)
+        {
+          throw InputError("--output " + dir.string() + ": cannot prepare the directory (" +
+                           e.code().message() + ")");
+        }
 
     JsonObject summary;
     summary.set("status", "running");
@@ -169,15 +251,6 @@ namespace tribo::app
       std::ostringstream os;
       prm.print_parameters(os, dealii::ParameterHandler::PRM);
       atomic_write((dir / "parameters.prm").string(), os.str());
-    }
-    std::map<std::string, std::string> resolved;
-    {
-      std::ostringstream os;
-      prm.print_parameters(os, dealii::ParameterHandler::JSON);
-      boost::property_tree::ptree tree;
-      std::istringstream          is(os.str());
-      boost::property_tree::read_json(is, tree);
-      collect(tree, "", resolved);
     }
 
     Log log;
@@ -209,13 +282,50 @@ namespace tribo::app
       columns.push_back(c);
     TimeSeries  stats(columns);
     FieldWriter fields((dir / "fields").string());
-    write_fields(fields, 0, system, mj, h, *scene);
 
     std::string   status = "complete", failure;
     unsigned long step = 0, total_iterations = 0, non_converged = 0, max_iterations = 0;
     double        worst_overlap = 0, t = 0, max_residual = 0;
+    double        wall_before = 0; ///< wall time of the run before its last resumption, s
+
+    // A checkpoint holds the resolved parameters, the loop's counters and every object's
+    // state, in this order (core/checkpoint.h).
+    const auto save_checkpoint = [&]() {
+      const double wall = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      write_checkpoint(checkpoint_file.string(), [&](CheckpointOut &ar) {
+        ar << resolved << step << total_iterations << non_converged << max_iterations
+           << worst_overlap << max_residual << wall;
+        system.save(ar);
+        mj.save(ar);
+        scene->save(ar);
+        stats.save(ar);
+        fields.save(ar);
+      });
+    };
+    if (resuming)
+      {
+        read_checkpoint(checkpoint_file.string(), [&](CheckpointIn &ar) {
+          std::map<std::string, std::string> saved;
+          ar >> saved;
+          log("resuming from " + checkpoint_file.string() + changes);
+          ar >> step >> total_iterations >> non_converged >> max_iterations >> worst_overlap >>
+            max_residual >> wall_before;
+          system.load(ar);
+          mj.load(ar);
+          scene->load(ar);
+          stats.load(ar);
+          fields.load(ar);
+        });
+        t = step * h;
+        std::ostringstream os;
+        os << "resumed at step " << step << " (t = " << t << " s) of " << n_steps;
+        log(os.str());
+      }
+    else
+      write_fields(fields, 0, system, mj, h, *scene);
+
     ProgressLine  progress(n_steps * h, !o.quiet);
-    auto          last_flush = std::chrono::steady_clock::now();
+    auto          last_flush = std::chrono::steady_clock::now(), last_checkpoint = last_flush;
     std::vector<double> last_row;
     try
       {
@@ -223,6 +333,7 @@ namespace tribo::app
           {
             if (stop_requested())
               {
+                save_checkpoint();
                 status = "interrupted";
                 break;
               }
@@ -261,6 +372,14 @@ namespace tribo::app
                 atomic_write((dir / "statistics.csv").string(), stats.to_csv());
                 last_flush = now;
               }
+            const bool timer = p.checkpoint_interval > 0 &&
+                               std::chrono::duration<double>(now - last_checkpoint).count() > p.checkpoint_interval;
+            const bool every = p.checkpoint_step_interval > 0 && step % p.checkpoint_step_interval == 0;
+            if (stopping || ((timer || every) && !last))
+              {
+                save_checkpoint();
+                last_checkpoint = std::chrono::steady_clock::now();
+              }
             progress.update(t, step);
             if (stopping)
               {
@@ -282,7 +401,7 @@ namespace tribo::app
     progress.finish();
     write_fields(fields, t, system, mj, h, *scene);
 
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double wall = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     summary.set("status", status);
     if (!failure.empty())
       summary.set("error", failure);
@@ -318,6 +437,8 @@ namespace tribo::app
       atomic_write((dir / (name + ".csv")).string(), table.to_csv());
     write_results_h5((dir / "results.h5").string(), stats, tables, resolved, scalars);
     atomic_write((dir / "summary.json").string(), summary.to_string());
+    if (status == "complete")
+      fs::remove(checkpoint_file);
 
     if (p.plots && p.scene == "shear" && status != "failed" && !stats.rows().empty())
       {

@@ -14,11 +14,18 @@ namespace tribo::app
     std::vector<std::string> overrides;  ///< "Subsection/Entry=value"
     bool                     quiet      = false;
     bool                     check_only = false;
+    /// Resume the run whose outputs are in this directory from its checkpoint.bin
+    /// (the outputs go on there); empty: a new run.
+    std::string              resume_dir;
   };
 
   /// Run (or only check) a case; returns the process exit code. Input errors
   /// are thrown as InputError before anything is written.
   int run_case(const RunOptions &options);
+
+  /// The "status" of DIR/summary.json (running, complete, interrupted, failed), or "" if
+  /// there is none or it cannot be read.
+  std::string run_status(const std::string &dir);
 
   /// The full documented parameter tree with defaults (`tribo params`).
   std::string parameter_reference();

@@ -43,6 +43,10 @@ namespace tribo::app
     virtual void summarize(const dem::ParticleSystem &, const TimeSeries &, JsonObject &) {}
     /// Extra tables, written as NAME.csv and as the HDF5 group NAME (after summarize()).
     virtual std::map<std::string, TimeSeries> tables() const { return {}; }
+    /// Checkpoint: the state the scene carries between steps (counters, phase, samples,
+    /// a deformable body), after build() and attach() have rebuilt the rest.
+    virtual void save(CheckpointOut &) const {}
+    virtual void load(CheckpointIn &) {}
 
   protected:
     explicit Scene(const CaseParameters &p) : prm(p) {}

@@ -1,6 +1,9 @@
 // Two discs in a head-on collision along x (Cao et al. 2011, Fig. 8).
 #include "app/scene.h"
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+
 #include <algorithm>
 #include <cmath>
 
@@ -83,6 +86,16 @@ namespace tribo::app
         j.set("final_gap", last_gap);
         j.set("contact_duration", contact_steps * time_step(s));
         j.set("elastic_contact_duration", M_PI * dt_star);
+      }
+
+      void save(CheckpointOut &ar) const override
+      {
+        ar << m_eff << energy_start << last_gap << peak_force << contact_steps << touched << separated;
+      }
+
+      void load(CheckpointIn &ar) override
+      {
+        ar >> m_eff >> energy_start >> last_gap >> peak_force >> contact_steps >> touched >> separated;
       }
 
     private:

@@ -22,7 +22,12 @@
 #include "coupling/elastic_boundary.h"
 #endif
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/string.hpp>
+
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -251,6 +256,31 @@ namespace tribo::app
         for (const auto &row : profiles->average(steady.start))
           table.add_row(row);
         return {{"profiles", table}};
+      }
+
+      void save(CheckpointOut &ar) const override
+      {
+        std::ostringstream random;
+        random << rng;
+        ar << random.str() << steps_done << sliding << normal_force;
+        profiles->save(ar);
+#ifdef TRIBO_WITH_FEM
+        if (elastic)
+          elastic->save(ar);
+#endif
+      }
+
+      void load(CheckpointIn &ar) override
+      {
+        std::string random;
+        ar >> random >> steps_done >> sliding >> normal_force;
+        std::istringstream is(random);
+        is >> rng;
+        profiles->load(ar);
+#ifdef TRIBO_WITH_FEM
+        if (elastic)
+          elastic->load(ar);
+#endif
       }
 
     private:

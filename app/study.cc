@@ -72,20 +72,6 @@ namespace tribo::app
       return os.str();
     }
 
-    std::string status_of(const fs::path &summary)
-    {
-      try
-        {
-          boost::property_tree::ptree tree;
-          boost::property_tree::read_json(summary.string(), tree);
-          return tree.get<std::string>("status", "");
-        }
-      catch (const std::exception &)
-        {
-          return "";
-        }
-    }
-
     /// A value of summary.json "results" (or the top level), or "" if absent/null.
     std::string value_of(const boost::property_tree::ptree &tree, const std::string &key)
     {
@@ -174,21 +160,24 @@ namespace tribo::app
       {
         const fs::path cd = case_dir(i);
         if (fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == overrides_text(i) &&
-            status_of(cd / "summary.json") == "complete")
+            run_status(cd.string()) == "complete")
           {
             if (!o.quiet)
               std::cout << "case " << i << ": complete, skipped" << std::endl;
             continue;
           }
+        // A case of this parameter set that stopped with a checkpoint goes on from it.
+        const bool resume = fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == overrides_text(i) &&
+                            fs::exists(cd / "checkpoint.bin") && run_status(cd.string()) != "failed";
         fs::create_directories(cd);
         atomic_write((cd / "study.prm").string(), overrides_text(i));
         RunOptions run;
         run.case_file  = base.string();
         run.overrides  = cases[i];
-        run.output_dir = cd.string();
+        (resume ? run.resume_dir : run.output_dir) = cd.string();
         run.quiet      = true;
         if (!o.quiet)
-          std::cout << "case " << i << " (rank " << rank << "): running" << std::endl;
+          std::cout << "case " << i << " (rank " << rank << "): " << (resume ? "resuming" : "running") << std::endl;
         try
           {
             run_case(run);
@@ -202,7 +191,7 @@ namespace tribo::app
             atomic_write((cd / "summary.json").string(), failed.to_string());
           }
         if (!o.quiet)
-          std::cout << "case " << i << ": " << status_of(cd / "summary.json") << std::endl;
+          std::cout << "case " << i << ": " << run_status(cd.string()) << std::endl;
         if (stop_requested())
           {
             // Ctrl-C or SIGTERM: the running case was closed as interrupted; stop here,

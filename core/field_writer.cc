@@ -5,6 +5,13 @@
 #include <deal.II/base/data_out_base.h>
 #include <deal.II/grid/reference_cell.h>
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/map.hpp>
+#include <boost/serialization/string.hpp>
+#include <boost/serialization/utility.hpp>
+#include <boost/serialization/vector.hpp>
+
 #include <cstdio>
 #include <sstream>
 
@@ -129,5 +136,14 @@ namespace tribo
     auto &files = series_files[series];
     files.emplace_back(t, file);
     atomic_write(dir + "/" + series + ".pvd", pvd_text(files));
+  }
+  void FieldWriter::save(CheckpointOut &ar) const
+  {
+    ar << disc_files << contact_files << series_files << times;
+  }
+
+  void FieldWriter::load(CheckpointIn &ar)
+  {
+    ar >> disc_files >> contact_files >> series_files >> times;
   }
 } // namespace tribo

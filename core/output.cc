@@ -2,6 +2,11 @@
 
 #include "core/errors.h"
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/string.hpp>
+#include <boost/serialization/vector.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
@@ -148,5 +153,19 @@ namespace tribo
       file << message << '\n' << std::flush;
     if (echo)
       std::cout << message << std::endl;
+  }
+  void TimeSeries::save(CheckpointOut &ar) const
+  {
+    ar << names << data;
+  }
+
+  void TimeSeries::load(CheckpointIn &ar)
+  {
+    std::vector<std::string> saved;
+    ar >> saved;
+    if (saved != names)
+      throw InputError("checkpoint: its statistics columns differ from this case's "
+                       "(another scene or another version of tribo)");
+    ar >> data;
   }
 } // namespace tribo

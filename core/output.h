@@ -4,6 +4,8 @@
 /// Every file is written to "NAME.tmp" and renamed, so a file that exists is
 /// complete as far as it goes (see docs/outputs.md).
 
+#include "core/checkpoint.h"
+
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -29,6 +31,9 @@ namespace tribo
     std::vector<double> column(const std::string &name) const;
     /// CSV text: a header of the column names, then full-precision rows.
     std::string to_csv() const;
+    /// Checkpoint: the columns and rows so far.
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
 
   private:
     std::vector<std::string>         names;
@@ -100,6 +105,9 @@ namespace tribo
     void index(const std::string &series, double t, const std::string &file);
     unsigned int n_snapshots() const { return static_cast<unsigned int>(times.size()); }
     const std::string &directory() const { return dir; }
+    /// Checkpoint: the snapshots indexed so far (the files themselves stay on disk).
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
 
   private:
     std::string                                 dir;

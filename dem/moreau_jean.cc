@@ -2,6 +2,10 @@
 
 #include "core/errors.h"
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/string.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -214,5 +218,35 @@ namespace tribo::dem
       }
     report.kinetic_energy = system.kinetic_energy();
     return report;
+  }
+  void MoreauJean::save(CheckpointOut &ar) const
+  {
+    // Sorted by key: the file does not depend on the hash table's layout.
+    std::vector<std::pair<std::uint64_t, Eigen::Vector2d>> impulses(previous_impulse.begin(),
+                                                                    previous_impulse.end());
+    std::sort(impulses.begin(), impulses.end(),
+              [](const auto &a, const auto &b) { return a.first < b.first; });
+    std::size_t n = impulses.size();
+    ar << n;
+    for (const auto &[key, r] : impulses)
+      ar << key << r.x() << r.y();
+    ar << solver.random_state();
+  }
+
+  void MoreauJean::load(CheckpointIn &ar)
+  {
+    std::size_t n;
+    ar >> n;
+    previous_impulse.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      {
+        std::uint64_t key;
+        double        rn, rt;
+        ar >> key >> rn >> rt;
+        previous_impulse[key] = {rn, rt};
+      }
+    std::string random;
+    ar >> random;
+    solver.set_random_state(random);
   }
 } // namespace tribo::dem

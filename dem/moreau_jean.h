@@ -75,6 +75,11 @@ namespace tribo::dem
     double theta() const { return th; }
     double detection_distance() const { return distance; }
 
+    /// Checkpoint: the impulses of the last step (the next step's warm start) and the
+    /// solver's random state. The attached boundary body saves its own state.
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
+
   private:
     double                   th;
     ContactLaw               contact_law;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <sstream>
 
 namespace tribo::dem
 {
@@ -67,6 +68,19 @@ namespace tribo::dem
     : prm(p)
     , rng(p.seed)
   {}
+
+  std::string NlgsSolver::random_state() const
+  {
+    std::ostringstream os;
+    os << rng;
+    return os.str();
+  }
+
+  void NlgsSolver::set_random_state(const std::string &state)
+  {
+    std::istringstream is(state);
+    is >> rng;
+  }
 
   NlgsReport NlgsSolver::solve(std::vector<Contact> &contacts, BodyState &state,
                                const ContactLaw &law, double theta_h)

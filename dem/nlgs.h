@@ -26,6 +26,7 @@
 
 #include <array>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace tribo::dem
@@ -137,6 +138,9 @@ namespace tribo::dem
                      double theta_h = 0);
 
     const NlgsParameters &parameters() const { return prm; }
+    /// The random generator's state as text (checkpoints), and its restoration.
+    std::string random_state() const;
+    void        set_random_state(const std::string &state);
 
   private:
     NlgsParameters            prm;

@@ -1,5 +1,10 @@
 #include "dem/particle_system.h"
 
+#include "core/errors.h"
+
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -66,5 +71,42 @@ namespace tribo::dem
     for (const auto &d : discs)
       r = std::max(r, d.radius);
     return r;
+  }
+  namespace
+  {
+    /// Both directions of a body's checkpoint, field by field (Ar: either archive).
+    template <class Ar, class Body>
+    void body_state(Ar &ar, Body &b)
+    {
+      ar &b.mass &b.inertia &b.position.x() &b.position.y() &b.angle &b.velocity.x() &b.velocity.y() &b.spin;
+      for (int k = 0; k < 3; ++k)
+        {
+          int drive = static_cast<int>(b.drive[k]);
+          ar &drive;
+          b.drive[k] = static_cast<Drive>(drive);
+          ar &b.load[k];
+        }
+    }
+  } // namespace
+
+  void ParticleSystem::save(CheckpointOut &ar) const
+  {
+    std::size_t n_bodies = bodies.size(), n_discs = discs.size();
+    ar << period << n_bodies << n_discs;
+    for (RigidBody b : bodies)
+      body_state(ar, b);
+  }
+
+  void ParticleSystem::load(CheckpointIn &ar)
+  {
+    std::size_t n_bodies, n_discs;
+    double      saved_period;
+    ar >> saved_period >> n_bodies >> n_discs;
+    if (n_bodies != bodies.size() || n_discs != discs.size() || saved_period != period)
+      throw InputError("checkpoint: it holds " + std::to_string(n_bodies) + " bodies and " +
+                       std::to_string(n_discs) + " discs, this case builds " +
+                       std::to_string(bodies.size()) + " and " + std::to_string(discs.size()));
+    for (RigidBody &b : bodies)
+      body_state(ar, b);
   }
 } // namespace tribo::dem

@@ -5,6 +5,8 @@
 /// kg m^2/m = kg m, forces in N/m, torques in N m/m = N, impulses in N s/m.
 /// Angles are counter-clockwise in radians, spins in rad/s.
 
+#include "core/checkpoint.h"
+
 #include <Eigen/Core>
 
 #include <array>
@@ -111,6 +113,10 @@ namespace tribo::dem
 
     /// Sum of the kinetic energies, J/m.
     double kinetic_energy() const;
+    /// Checkpoint: every body's state and load (the discs are rebuilt with the scene and
+    /// checked against the saved count).
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
     /// Smallest disc radius, m.
     double min_radius() const;
     /// Largest disc radius, m.

@@ -25,6 +25,9 @@
 #include <deal.II/numerics/vector_tools_point_gradient.h>
 #include <deal.II/numerics/vector_tools_point_value.h>
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+
 #include <cholmod.h>
 
 #include <algorithm>
@@ -652,6 +655,28 @@ namespace tribo::fem
     c.distribute(f);
     m.u         = f;
     m.v         = 0;
+    m.predicted = false;
+  }
+
+  void ElasticBody::save(CheckpointOut &ar) const
+  {
+    const Impl &m = *impl;
+    ar << m.prm.rayleigh_mass << m.prm.rayleigh_stiffness << m.t << m.u << m.v << m.v_prev;
+    ar << m.p_load << m.p_contact << m.p_damping << m.w_load << m.w_contact << m.w_damping;
+  }
+
+  void ElasticBody::load(CheckpointIn &ar)
+  {
+    Impl  &m = *impl;
+    double a, b;
+    ar >> a >> b;
+    set_damping(a, b);
+    const auto n = m.u.size();
+    ar >> m.t >> m.u >> m.v >> m.v_prev;
+    if (m.u.size() != n)
+      throw InputError("checkpoint: the deformable body has " + std::to_string(m.u.size() / 2) +
+                       " nodes in it, this case builds " + std::to_string(n / 2));
+    ar >> m.p_load >> m.p_contact >> m.p_damping >> m.w_load >> m.w_contact >> m.w_damping;
     m.predicted = false;
   }
 

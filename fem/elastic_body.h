@@ -36,6 +36,8 @@
 /// with per-step works h f.vbar, h vbar.C v_theta and R.vbar, vbar = (v + v_end)/2.
 /// theta > 1/2 adds numerical dissipation (not reported).
 
+#include "core/checkpoint.h"
+
 #include <Eigen/Core>
 
 #include <memory>
@@ -173,6 +175,12 @@ namespace tribo::fem
     /// sigma_yy, sigma_xy, sigma_zz = nu (sigma_xx + sigma_yy) and von Mises (Pa) on
     /// the reference mesh, atomically (a temporary file, then a rename).
     void write_vtu(const std::string &filename) const;
+
+    /// Checkpoint: displacement, velocity, time, the Rayleigh coefficients in force and
+    /// the accumulated works. load() refactorises if the coefficients differ from the
+    /// constructed body's (e.g. compaction damping removed at Shear start).
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
 
   private:
     struct Impl;

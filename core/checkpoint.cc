@@ -1,0 +1,63 @@
+#include "core/checkpoint.h"
+
+#include "core/errors.h"
+#include "core/output.h"
+
+#include <boost/archive/archive_exception.hpp>
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/string.hpp>
+
+#include <fstream>
+#include <sstream>
+
+namespace tribo
+{
+  namespace
+  {
+    /// First entry of every checkpoint: what it is and its layout version.
+    const std::string magic = "tribo checkpoint 1";
+  } // namespace
+
+  void write_checkpoint(const std::string &path, const std::function<void(CheckpointOut &)> &save)
+  {
+    std::ostringstream os(std::ios::binary);
+    {
+      CheckpointOut ar(os);
+      ar << magic;
+      save(ar);
+      const std::string end = "end";
+      ar << end;
+    }
+    atomic_write(path, os.str());
+  }
+
+  void read_checkpoint(const std::string &path, const std::function<void(CheckpointIn &)> &load,
+                       bool whole)
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+      throw InputError("checkpoint " + path + ": cannot be read (no checkpoint was written there?)");
+    try
+      {
+        CheckpointIn ar(in);
+        std::string  head;
+        ar >> head;
+        if (head != magic)
+          throw InputError("checkpoint " + path + ": not a checkpoint of this version of tribo");
+        load(ar);
+        if (!whole)
+          return;
+        std::string end;
+        ar >> end;
+        if (end != "end")
+          throw InputError("checkpoint " + path + ": its content does not match this case "
+                           "(the state ends in the wrong place)");
+      }
+    catch (const boost::archive::archive_exception &e)
+      {
+        throw InputError("checkpoint " + path + ": unreadable (" + std::string(e.what()) +
+                         "); it was written by another build or for another case");
+      }
+  }
+} // namespace tribo
