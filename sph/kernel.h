@@ -1,0 +1,36 @@
+#pragma once
+/// @file Cubic-spline (M4) SPH kernel of Monaghan and Lattanzio (1985).
+
+#include <deal.II/base/tensor.h>
+
+namespace tribo::sph
+{
+  using dealii::Tensor;
+
+  /// The M4 cubic spline with compact support 2h, q = r/h:
+  ///
+  ///   W(r, h) = sigma_d [1 - 3/2 q^2 + 3/4 q^3]   for 0 <= q < 1,
+  ///           = sigma_d (2 - q)^3 / 4              for 1 <= q < 2,
+  ///           = 0                                  for q >= 2,
+  ///
+  /// with sigma_2 = 10 / (7 pi h^2) (1/m^2) and sigma_3 = 1 / (pi h^3) (1/m^3), so
+  /// that the integral of W over the plane (space) is 1. The gradient with respect
+  /// to the position x_i of the first particle, r = x_i - x_j, is
+  /// grad_i W = (dW/dr) r / |r|: it points from i towards j (dW/dr <= 0), i.e.
+  /// along -r for a repulsive pressure force.
+  template <int dim>
+  class CubicSplineKernel
+  {
+  public:
+    /// Normalisation sigma_d (1/m^dim) for smoothing length @p h (m).
+    static double normalisation(double h);
+    /// W(r, h), 1/m^dim; @p r >= 0 the distance, m.
+    static double value(double r, double h);
+    /// dW/dr (1/m^(dim+1)); <= 0 everywhere, 0 at r = 0 and r >= 2h.
+    static double derivative(double r, double h);
+    /// grad_i W for separation @p rij = x_i - x_j, 1/m^(dim+1).
+    static Tensor<1, dim> gradient(const Tensor<1, dim> &rij, double h);
+    /// Support radius 2h, m.
+    static double support(double h) { return 2 * h; }
+  };
+} // namespace tribo::sph

@@ -1,0 +1,381 @@
+#include "sph/solver.h"
+
+#include "core/errors.h"
+
+#include <deal.II/base/parallel.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace tribo::sph
+{
+  namespace
+  {
+    template <int dim>
+    std::string vec_text(const Tensor<1, dim> &a)
+    {
+      std::string s = "(";
+      for (unsigned int d = 0; d < dim; ++d)
+        s += (d ? ", " : "") + to_text(a[d]);
+      return s + ")";
+    }
+
+    template <int dim>
+    void resize(Rates<dim> &k, unsigned int n)
+    {
+      k.dx.assign(n, Tensor<1, dim>());
+      k.dv.assign(n, Tensor<1, dim>());
+      k.drho.assign(n, 0);
+      k.de.assign(n, 0);
+      k.dS.assign(n, SymmetricTensor<2, dim>());
+      k.boundary_force.assign(n, Tensor<1, dim>());
+      k.pressure.assign(n, 0);
+      k.signal.assign(n, 0);
+    }
+
+    template <typename F>
+    void parallel_for(unsigned int n, F &&f)
+    {
+      dealii::parallel::apply_to_subranges(
+        0U, n,
+        [&](unsigned int b, unsigned int e) {
+          for (unsigned int i = b; i < e; ++i)
+            f(i);
+        },
+        128);
+    }
+  } // namespace
+
+  template <int dim>
+  Solver<dim>::Solver(const std::vector<Material> &materials, const SolverParameters &parameters)
+    : mats(materials)
+    , prm(parameters)
+    , search(parameters.period)
+  {
+    if (mats.empty())
+      throw InputError("SPH solver: no material given");
+  }
+
+  template <int dim>
+  std::string Solver<dim>::describe_particle(const ParticleState<dim> &s, unsigned int i) const
+  {
+    return "particle " + std::to_string(i) + " (x = " + vec_text(s.x[i]) +
+           " m, v = " + vec_text(s.v[i]) + " m/s, rho = " + to_text(s.rho[i]) + " kg/m^3)";
+  }
+
+  template <int dim>
+  void Solver<dim>::compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k)
+  {
+    const unsigned int n = s.size();
+    resize(k, n);
+    double h_max = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      h_max = std::max(h_max, s.h[i]);
+    search.period = prm.period;
+    search.build(s.x, std::max(2 * h_max, prm.boundary.range()));
+
+    // Per-particle pressure, longitudinal sound speed and sigma/rho^2.
+    std::vector<double>                  c(n);
+    std::vector<SymmetricTensor<2, dim>> A(n);
+    parallel_for(n, [&](unsigned int i) {
+      const Material &m  = mats[s.material[i]];
+      const auto      ps = m.evaluate(s.rho[i], s.e[i]);
+      k.pressure[i]      = ps.pressure;
+      c[i] = std::sqrt(ps.sound_speed * ps.sound_speed + 4 * m.shear_modulus / (3 * s.rho[i]));
+      A[i] = (s.S[i] - ps.pressure * dealii::unit_symmetric_tensor<dim>()) / (s.rho[i] * s.rho[i]);
+    });
+
+    const BoundaryForce &bf        = prm.boundary;
+    const double         bf_range2 = bf.range() * bf.range();
+    const double         alpha = prm.alpha, beta = prm.beta, eps = prm.av_epsilon;
+    parallel_for(n, [&](unsigned int i) {
+      Tensor<1, dim> acc, fb;
+      Tensor<2, dim> L, M;
+      double         drho = 0, de = 0, max_mu = 0;
+      for (unsigned int q = search.start[i]; q < search.start[i + 1]; ++q)
+        {
+          const unsigned int   j  = search.list[q];
+          const Tensor<1, dim> r  = search.separation(s.x[i], s.x[j]);
+          const double         r2 = r.norm_square();
+          if (s.body[i] != s.body[j])
+            {
+              if (r2 < bf_range2 && r2 > 0)
+                {
+                  const double dist  = std::sqrt(r2);
+                  const double scale = bf.per_unit_mass() ? 0.5 * (s.mass[i] + s.mass[j]) : 1.0;
+                  fb += (scale * bf.value(dist) / dist) * r;
+                }
+              continue;
+            }
+          const double hij = 0.5 * (s.h[i] + s.h[j]);
+          if (r2 >= 4 * hij * hij)
+            continue;
+          const Tensor<1, dim> g  = CubicSplineKernel<dim>::gradient(r, hij);
+          const Tensor<1, dim> dv = s.v[i] - s.v[j];
+          const double         mj = s.mass[j];
+          const double         dvg = dv * g;
+          drho += mj * dvg;
+          double       Pi = 0;
+          const double vr = dv * r;
+          if (vr < 0)
+            {
+              const double mu = hij * vr / (r2 + eps * hij * hij);
+              Pi = (-alpha * 0.5 * (c[i] + c[j]) * mu + beta * mu * mu) /
+                   (0.5 * (s.rho[i] + s.rho[j]));
+              max_mu = std::max(max_mu, -mu);
+            }
+          const SymmetricTensor<2, dim> pair = A[i] + A[j];
+          acc += mj * (pair * g - Pi * g);
+          de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);
+          L -= (mj / s.rho[j]) * dealii::outer_product(dv, g);
+          M -= (mj / s.rho[j]) * dealii::outer_product(r, g);
+        }
+      if (prm.corrected_gradient)
+        {
+          const double det = dealii::determinant(M);
+          if (std::isfinite(det) && det > std::pow(0.05, dim))
+            L = L * dealii::invert(M);
+        }
+      const double G = mats[s.material[i]].shear_modulus;
+      const SymmetricTensor<2, dim> eps_dot = dealii::symmetrize(L);
+      const Tensor<2, dim>          omega   = 0.5 * (L - dealii::transpose(L));
+      const Tensor<2, dim>          S(s.S[i]);
+      const Tensor<2, dim>          rot = omega * S - S * omega;
+      k.dS[i] = 2 * G * (eps_dot - dealii::trace(eps_dot) / 3.0 * dealii::unit_symmetric_tensor<dim>()) +
+                dealii::symmetrize(rot);
+      k.dv[i]             = acc + fb / s.mass[i];
+      k.boundary_force[i] = fb;
+      k.drho[i]           = drho;
+      k.de[i]             = de;
+      k.dx[i]             = s.v[i];
+      k.signal[i]         = c[i] * (1 + 1.2 * alpha) + beta * max_mu;
+    });
+
+    for (const auto &ef : external)
+      {
+        const double ramp = ef.tau > 0 ? 1 - std::exp(-t / ef.tau) : 1.0;
+        for (unsigned int i : ef.particles)
+          k.dv[i] += (ramp / s.mass[i]) * ef.force;
+      }
+    for (const auto &iv : imposed)
+      for (unsigned int i : iv.particles)
+        {
+          k.dv[i] = Tensor<1, dim>();
+          k.dx[i] = s.v[i];
+        }
+  }
+
+  template <int dim>
+  double Solver<dim>::stable_step(const ParticleState<dim> &s, const Rates<dim> &k,
+                                  std::string &lim, std::vector<unsigned int> &worst) const
+  {
+    const unsigned int  n = s.size();
+    std::vector<double> dt_i(n);
+    std::vector<char>   by_acc(n, 0);
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        const double dt_c = prm.courant * s.h[i] / k.signal[i];
+        const double a    = k.dv[i].norm();
+        const double dt_a = a > 0 ? prm.acceleration_factor * std::sqrt(s.h[i] / a)
+                                  : std::numeric_limits<double>::infinity();
+        dt_i[i]   = std::min(dt_c, dt_a);
+        by_acc[i] = dt_a < dt_c;
+      }
+    std::vector<unsigned int> order(n);
+    std::iota(order.begin(), order.end(), 0U);
+    const unsigned int n_worst = std::min(5U, n);
+    std::partial_sort(order.begin(), order.begin() + n_worst, order.end(),
+                      [&](unsigned int a, unsigned int b) {
+                        return dt_i[a] < dt_i[b] || (dt_i[a] == dt_i[b] && a < b);
+                      });
+    worst.assign(order.begin(), order.begin() + n_worst);
+    if (n == 0)
+      {
+        lim = "dt_max";
+        return prm.dt_max;
+      }
+    lim = by_acc[order[0]] ? "acceleration" : "CFL";
+    return dt_i[order[0]];
+  }
+
+  template <int dim>
+  void Solver<dim>::apply_imposed(ParticleState<dim> &s, double t) const
+  {
+    for (const auto &iv : imposed)
+      for (unsigned int i : iv.particles)
+        s.v[i] = iv.field ? iv.field(s.x[i], t) : iv.velocity;
+  }
+
+  template <int dim>
+  void Solver<dim>::apply_damping(ParticleState<dim> &s, double dt) const
+  {
+    if (damping.empty())
+      return;
+    std::vector<char> fixed(s.size(), 0);
+    for (const auto &iv : imposed)
+      for (unsigned int i : iv.particles)
+        fixed[i] = 1;
+    for (const auto &d : damping)
+      {
+        Tensor<1, dim> p;
+        double         m = 0;
+        for (unsigned int i = 0; i < s.size(); ++i)
+          if (s.body[i] == d.body)
+            {
+              p += s.mass[i] * s.v[i];
+              m += s.mass[i];
+            }
+        if (m == 0)
+          continue;
+        Tensor<1, dim> vcm = p / m;
+        if (!d.relative_to_centre_of_mass)
+          for (unsigned int c = 0; c < dim; ++c)
+            vcm[c] = d.reference_velocity[c];
+        const double         f   = std::exp(-d.gamma * dt);
+        for (unsigned int i = 0; i < s.size(); ++i)
+          if (s.body[i] == d.body && !fixed[i])
+            s.v[i] = vcm + f * (s.v[i] - vcm);
+      }
+  }
+
+  template <int dim>
+  void Solver<dim>::check_finite(const ParticleState<dim> &s, const std::string &where) const
+  {
+    std::vector<unsigned int> bad;
+    for (unsigned int i = 0; i < s.size() && bad.size() < 5; ++i)
+      {
+        bool ok = std::isfinite(s.rho[i]) && s.rho[i] > 0 && std::isfinite(s.e[i]);
+        for (unsigned int d = 0; d < dim; ++d)
+          ok = ok && std::isfinite(s.x[i][d]) && std::isfinite(s.v[i][d]);
+        for (unsigned int a = 0; a < dim; ++a)
+          for (unsigned int b = a; b < dim; ++b)
+            ok = ok && std::isfinite(s.S[i][a][b]);
+        if (!ok)
+          bad.push_back(i);
+      }
+    if (bad.empty())
+      return;
+    std::string msg = "SPH: NaN/Inf or non-positive density " + where + " at t = " +
+                      to_text(time) + " s in";
+    for (unsigned int i : bad)
+      msg += " " + describe_particle(s, i) + ";";
+    throw RunError(msg);
+  }
+
+  template <int dim>
+  double Solver<dim>::step(double dt_limit)
+  {
+    const unsigned int n = state.size();
+    apply_imposed(state, time);
+    compute_rates(state, time, k1);
+    {
+      std::vector<unsigned int> bad;
+      for (unsigned int i = 0; i < n && bad.size() < 5; ++i)
+        {
+          bool ok = std::isfinite(k1.drho[i]) && std::isfinite(k1.de[i]);
+          for (unsigned int d = 0; d < dim; ++d)
+            ok = ok && std::isfinite(k1.dv[i][d]);
+          if (!ok)
+            bad.push_back(i);
+        }
+      if (!bad.empty())
+        {
+          std::string msg = "SPH: NaN/Inf rate at t = " + to_text(time) + " s in";
+          for (unsigned int i : bad)
+            msg += " " + describe_particle(state, i) + ";";
+          throw RunError(msg);
+        }
+    }
+    std::vector<unsigned int> worst;
+    double                    dt = stable_step(state, k1, limiter, worst);
+    if (dt < prm.dt_min)
+      {
+        std::string msg = "SPH time step " + to_text(dt) + " s fell below the step floor dt_min = " +
+                          to_text(prm.dt_min) + " s, limited by the " + limiter +
+                          " condition, at t = " + to_text(time) + " s; smallest steps in";
+        for (unsigned int i : worst)
+          msg += " " + describe_particle(state, i) + ";";
+        throw RunError(msg);
+      }
+    if (prm.dt_max < dt)
+      {
+        dt      = prm.dt_max;
+        limiter = "dt_max";
+      }
+    if (dt_limit < dt)
+      {
+        dt      = dt_limit;
+        limiter = "dt_limit";
+      }
+
+    // Predictor to the midpoint.
+    mid = state;
+    parallel_for(n, [&](unsigned int i) {
+      const double hdt = 0.5 * dt;
+      mid.x[i] += hdt * k1.dx[i];
+      mid.v[i] += hdt * k1.dv[i];
+      mid.rho[i] += hdt * k1.drho[i];
+      mid.e[i] += hdt * k1.de[i];
+      mid.S[i] += hdt * k1.dS[i];
+    });
+    apply_imposed(mid, time + 0.5 * dt);
+    compute_rates(mid, time + 0.5 * dt, k2);
+    parallel_for(n, [&](unsigned int i) {
+      state.x[i] += dt * k2.dx[i];
+      state.v[i] += dt * k2.dv[i];
+      state.rho[i] += dt * k2.drho[i];
+      state.e[i] += dt * k2.de[i];
+      state.S[i] += dt * k2.dS[i];
+      if (prm.period > 0)
+        state.x[i][0] -= prm.period * std::floor(state.x[i][0] / prm.period);
+    });
+    apply_damping(state, dt);
+    time += dt;
+    apply_imposed(state, time);
+    check_finite(state, "after the step");
+    return dt;
+  }
+
+  template <int dim>
+  unsigned int Solver<dim>::advance_to(double t_end)
+  {
+    unsigned int steps = 0;
+    while (time < t_end * (1 - 1e-14))
+      {
+        step(t_end - time);
+        ++steps;
+      }
+    return steps;
+  }
+
+  template <int dim>
+  std::vector<double> interpolate(const ParticleState<dim> &s, const NeighbourSearch<dim> &ns,
+                                  const std::vector<double> &f)
+  {
+    const unsigned int  n = s.size();
+    std::vector<double> out(n);
+    parallel_for(n, [&](unsigned int i) {
+      double sum = s.mass[i] / s.rho[i] * f[i] * CubicSplineKernel<dim>::value(0, s.h[i]);
+      for (unsigned int q = ns.start[i]; q < ns.start[i + 1]; ++q)
+        {
+          const unsigned int j = ns.list[q];
+          if (s.body[j] != s.body[i])
+            continue;
+          const double r = ns.separation(s.x[i], s.x[j]).norm();
+          sum += s.mass[j] / s.rho[j] * f[j] *
+                 CubicSplineKernel<dim>::value(r, 0.5 * (s.h[i] + s.h[j]));
+        }
+      out[i] = sum;
+    });
+    return out;
+  }
+
+  template class Solver<2>;
+  template class Solver<3>;
+  template std::vector<double> interpolate<2>(const ParticleState<2> &, const NeighbourSearch<2> &,
+                                              const std::vector<double> &);
+  template std::vector<double> interpolate<3>(const ParticleState<3> &, const NeighbourSearch<3> &,
+                                              const std::vector<double> &);
+} // namespace tribo::sph

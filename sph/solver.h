@@ -1,0 +1,189 @@
+#pragma once
+/// @file Solid SPH equations (Maveyraud et al. 1999; Benz and Asphaug 1995) and
+/// their second-order Runge-Kutta integrator with adaptive step.
+///
+/// SI units throughout; 2D is plane strain with masses and forces per metre of
+/// depth. Pressure positive in compression, sigma = -P I + S, tension positive.
+
+#include "sph/boundary_force.h"
+#include "sph/eos.h"
+#include "sph/kernel.h"
+#include "sph/particles.h"
+
+#include <array>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace tribo::sph
+{
+  /// Numerical parameters of the solver.
+  struct SolverParameters
+  {
+    double alpha      = 1.0;  ///< Monaghan viscosity, linear term (paper: 1)
+    double beta       = 0.1;  ///< Monaghan viscosity, quadratic term (paper: 0.1)
+    double av_epsilon = 0.01; ///< eps in mu_ij = h v.r/(r^2 + eps h^2)
+    double courant    = 0.3;  ///< C in dt = C h/(c + 1.2 alpha c + beta max mu_ij)
+    double acceleration_factor = 0.25; ///< C_a in dt = C_a sqrt(h/|a|)
+    double dt_max = std::numeric_limits<double>::infinity(); ///< largest step, s
+    double dt_min = 1e-15; ///< step floor, s: a smaller step throws RunError
+    double period = 0;     ///< period along x, m (0: not periodic); x wrapped into [0, period)
+    BoundaryForce boundary; ///< force between particles of different bodies
+    /// Corrected velocity gradient for the stress rate: L_i <- L_i M_i^-1 with
+    /// M_i = sum_j (m_j/rho_j)(x_j - x_i) (x) grad_i W_ij (Bonet and Lok 1999),
+    /// exact for linear velocity fields also near free surfaces; falls back to
+    /// L_i where det M_i < 0.05^dim (M = I with a full
+    /// kernel support, ~2^-dim I at a corner). false: the paper's eqs. (20), (24) as written.
+    bool corrected_gradient = true;
+  };
+
+  /// Particles whose velocity is imposed (e.g. the top layers moved
+  /// horizontally, the bottom layer fixed with velocity 0): v_i = velocity,
+  /// dv_i/dt = 0, x_i moves with the imposed velocity. They are not damped.
+  /// If @p field is set, the velocity is field(x_i, t) instead (e.g. a rigid
+  /// rotation), re-evaluated at each Runge-Kutta stage.
+  template <int dim>
+  struct ImposedVelocity
+  {
+    std::vector<unsigned int> particles;
+    Tensor<1, dim>            velocity; ///< m/s
+    std::function<Tensor<1, dim>(const Tensor<1, dim> &x, double t)> field;
+  };
+
+  /// An external force on each listed particle, ramped in time:
+  /// F_i(t) = force (1 - exp(-t/tau)) (tau = 0: no ramp). For a pressure P on a
+  /// face of area A carried by n particles, force = -P A/n along the outward
+  /// normal. Units N (N/m in 2D).
+  template <int dim>
+  struct ExternalForce
+  {
+    std::vector<unsigned int> particles;
+    Tensor<1, dim>            force; ///< per particle, N
+    double                    tau = 0; ///< ramp time, s
+  };
+
+  /// Damping of body @p body relative to its centre-of-mass velocity,
+  /// f_i = -m_i gamma (v_i - v_cm) (paper's eq. 36), integrated exactly over a
+  /// step: v_i <- v_cm + (v_i - v_cm) exp(-gamma dt), which keeps the body's
+  /// momentum and sets no step limit. Its heat is not added to e (the paper's
+  /// choice: radiated away).
+  ///
+  /// With @p relative_to_centre_of_mass = false the reference velocity is the
+  /// fixed @p reference_velocity instead of v_cm (the paper's section 2.7 form
+  /// -m gamma (v - V) with V the sliding velocity); then momentum is not kept.
+  struct Damping
+  {
+    unsigned int          body;
+    double                gamma; ///< 1/s
+    bool                  relative_to_centre_of_mass = true;
+    std::array<double, 3> reference_velocity = {{0, 0, 0}}; ///< m/s (first dim used)
+  };
+
+  /// Time derivatives of the state and by-products of one evaluation.
+  template <int dim>
+  struct Rates
+  {
+    std::vector<Tensor<1, dim>>          dx;   ///< m/s
+    std::vector<Tensor<1, dim>>          dv;   ///< m/s^2
+    std::vector<double>                  drho; ///< kg/m^3/s
+    std::vector<double>                  de;   ///< J/kg/s
+    std::vector<SymmetricTensor<2, dim>> dS;   ///< Pa/s
+    std::vector<Tensor<1, dim>> boundary_force; ///< force on i from other bodies, N
+    std::vector<double>         pressure;       ///< P_i, Pa
+    std::vector<double>         signal;         ///< c_i + 1.2 alpha c_i + beta max_j mu_ij, m/s
+  };
+
+  /// The solid SPH model and its integrator. Pairs of particles of the same body
+  /// interact through the SPH equations (W the cubic spline with h_ij = (h_i+h_j)/2,
+  /// grad_i W_ij its gradient with respect to x_i):
+  ///
+  /// - continuity: drho_i/dt = sum_j m_j (v_i - v_j).grad_i W_ij
+  /// - momentum: dv_i/dt = sum_j m_j (sigma_i/rho_i^2 + sigma_j/rho_j^2 - Pi_ij I).grad_i W_ij
+  ///   + (boundary + external forces)/m_i, sigma = -P I + S;
+  /// - energy: de_i/dt = sum_j m_j [(v_j - v_i).(sigma_i/rho_i^2).grad_i W_ij
+  ///   + Pi_ij/2 (v_i - v_j).grad_i W_ij]; this pairs exactly with the momentum
+  ///   equation so that sum m (|v|^2/2 + e) is conserved (e holds the elastic work);
+  /// - velocity gradient: L_i^{ab} = sum_j (m_j/rho_j)(v_j^a - v_i^a) grad_i^b W_ij
+  ///   (times M_i^-1 if SolverParameters::corrected_gradient), strain rate eps_dot = (L + L^T)/2, spin Omega = (L - L^T)/2;
+  /// - Hooke with Jaumann rate: dS/dt = 2G (eps_dot - tr(eps_dot)/3 I) + Omega S - S Omega
+  ///   (= S Omega^T + Omega S, the paper's eq. 22). For a rigid rotation with
+  ///   angular velocity w (Omega_yx = w), S(t) = Q(wt) S0 Q(wt)^T. In 2D
+  ///   (plane strain) tr(eps_dot) is the in-plane trace, and S_zz = -(S_xx + S_yy);
+  /// - Monaghan viscosity: for (v_i - v_j).(x_i - x_j) < 0,
+  ///   mu_ij = h_ij (v_i - v_j).(x_i - x_j) / (|x_i - x_j|^2 + eps h_ij^2),
+  ///   Pi_ij = (-alpha cbar_ij mu_ij + beta mu_ij^2) / rhobar_ij, else 0.
+  ///
+  /// The sound speed c_i used in the viscosity and the step is the longitudinal
+  /// speed sqrt(c_EOS^2 + 4G/(3 rho_i)). Pairs of particles of different bodies
+  /// interact only through SolverParameters::boundary.
+  ///
+  /// All loops gather per particle over a full neighbour list (TBB through
+  /// deal.II), so results do not depend on the number of threads.
+  template <int dim>
+  class Solver
+  {
+  public:
+    Solver(const std::vector<Material> &materials, const SolverParameters &parameters);
+
+    ParticleState<dim>                state;
+    double                            time = 0; ///< s
+    std::vector<ImposedVelocity<dim>> imposed;
+    std::vector<ExternalForce<dim>>   external;
+    std::vector<Damping>              damping;
+
+    /// One step of the midpoint Runge-Kutta scheme
+    /// y* = y + dt/2 f(y, t), y' = y + dt f(y*, t + dt/2), then exact damping over
+    /// dt and imposed velocities. dt = min(dt_max, @p dt_limit, CFL, acceleration
+    /// steps over all particles), evaluated with f(y, t). Returns dt.
+    /// Throws RunError if dt < dt_min (naming the limit and the particles) or if
+    /// a rate or the new state holds NaN/Inf or a non-positive density.
+    double step(double dt_limit = std::numeric_limits<double>::infinity());
+    /// Steps until time reaches @p t_end (the last step is shortened). Returns the
+    /// number of steps.
+    unsigned int advance_to(double t_end);
+
+    /// Evaluates all rates at state @p s and time @p t into @p k.
+    void compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k);
+    /// The largest stable step for rates @p k at state @p s, s; @p limiter is set
+    /// to "CFL" or "acceleration" and @p worst to the particles with the smallest
+    /// steps (up to 5, smallest first).
+    double stable_step(const ParticleState<dim> &s, const Rates<dim> &k, std::string &limiter,
+                       std::vector<unsigned int> &worst) const;
+
+    /// The rates of the last midpoint evaluation (the ones that advanced the
+    /// state): boundary forces for friction measurements, pressures.
+    const Rates<dim> &last_rates() const { return k2; }
+    /// Name of the limit that set the last step ("CFL", "acceleration", "dt_max", "dt_limit").
+    const std::string &last_limiter() const { return limiter; }
+    /// The neighbour search (as of the last evaluation).
+    const NeighbourSearch<dim> &neighbours() const { return search; }
+    const std::vector<Material> &materials() const { return mats; }
+    const SolverParameters &parameters() const { return prm; }
+
+    /// Sum of m (|v|^2/2 + e), J: conserved without damping, boundary or external forces.
+    double total_energy() const { return state.kinetic_energy() + state.internal_energy(); }
+
+    /// "particle i (x = (..), v = (..), rho = ..)" for error messages.
+    std::string describe_particle(const ParticleState<dim> &s, unsigned int i) const;
+
+  private:
+    void apply_imposed(ParticleState<dim> &s, double t) const;
+    void apply_damping(ParticleState<dim> &s, double dt) const;
+    void check_finite(const ParticleState<dim> &s, const std::string &where) const;
+
+    std::vector<Material> mats;
+    SolverParameters      prm;
+    NeighbourSearch<dim>  search;
+    Rates<dim>            k1, k2;
+    ParticleState<dim>    mid;
+    std::string           limiter;
+  };
+
+  /// SPH interpolation at the particles, f~_i = sum_j (m_j/rho_j) f_j W_ij
+  /// including j = i, over particles of the same body (neighbour list @p ns must
+  /// be built with cut-off >= 2 max h).
+  template <int dim>
+  std::vector<double> interpolate(const ParticleState<dim> &s, const NeighbourSearch<dim> &ns,
+                                   const std::vector<double> &f);
+} // namespace tribo::sph
