@@ -1,6 +1,7 @@
 #include "app/run.h"
 
 #include "app/case_parameters.h"
+#include "app/particle_scenes.h"
 #include "app/scene.h"
 #include "core/checkpoint.h"
 #include "core/errors.h"
@@ -130,6 +131,9 @@ namespace tribo::app
     }
   } // namespace
 
+  bool is_sph_scene(const std::string &scene) { return scene.rfind("sph_", 0) == 0; }
+  bool is_mlp_scene(const std::string &scene) { return scene.rfind("mlp_", 0) == 0; }
+
   std::string run_status(const std::string &dir)
   {
     try
@@ -182,6 +186,16 @@ namespace tribo::app
     for (const auto &s : o.overrides)
       file.set(s);
     const CaseParameters p = read_case_parameters(file);
+#ifndef TRIBO_WITH_SPH_SCENES
+    if (is_sph_scene(p.scene))
+      throw InputError(o.case_file + ": Simulation/Scene = " + p.scene +
+                       " is not in this build (the SPH scenes need TRIBO_WITH_SPH=ON)");
+#endif
+#ifndef TRIBO_WITH_MLP_SCENES
+    if (is_mlp_scene(p.scene))
+      throw InputError(o.case_file + ": Simulation/Scene = " + p.scene +
+                       " is not in this build (the MLP scenes need TRIBO_WITH_MLP=ON)");
+#endif
     if (o.check_only)
       {
         if (!o.quiet)
@@ -256,6 +270,16 @@ namespace tribo::app
     Log log;
     log.open((dir / "log.txt").string(), !o.quiet);
     log("tribo run " + o.case_file + " -> " + dir.string());
+
+    // The explicit particle modules run their own time loop (app/particle_scenes.h).
+#ifdef TRIBO_WITH_SPH_SCENES
+    if (is_sph_scene(p.scene))
+      return run_sph_scene(file, dir.string(), log, o);
+#endif
+#ifdef TRIBO_WITH_MLP_SCENES
+    if (is_mlp_scene(p.scene))
+      return run_mlp_scene(file, dir.string(), log, o);
+#endif
 
     install_stop_handlers();
     const auto wall_start = std::chrono::steady_clock::now();
