@@ -65,8 +65,10 @@ namespace tribo::app
     prm.declare_entry("Relaxation", "1", Double(), "Relaxation omega in (0, 1]: r = omega r_law + (1 - omega) r_old.");
     prm.declare_entry("Check interval", "10", Integer(1), "Sweeps between convergence checks, >= 1.");
     prm.declare_entry("Maximum iterations", "10000", Integer(1), "Maximum number of sweeps per step, >= 1.");
-    prm.declare_entry("Contact order", "fixed", Selection("fixed|random"),
-                      "Order of the local solves: 'fixed' (detection order) or 'random' (shuffled every sweep).");
+    prm.declare_entry("Contact order", "fixed", Selection("fixed|alternating|random"),
+                      "Order of the local solves: 'fixed' (detection order: cells by rows, bottom to "
+                      "top), 'alternating' (that order and its reverse in turn, a symmetric Gauss-Seidel) "
+                      "or 'random' (shuffled every sweep).");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the random contact order.");
     prm.declare_entry("Gap tolerance", "0", Double(),
                       "Extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
@@ -191,7 +193,10 @@ namespace tribo::app
                                         "a relaxation in (0, 1]");
     p.solver.check_interval = f.get_integer("Solver/Check interval");
     p.solver.max_iterations = f.get_integer("Solver/Maximum iterations");
-    p.solver.random_order   = f.get("Solver/Contact order") == "random";
+    const std::string order = f.get("Solver/Contact order");
+    p.solver.order = order == "random"        ? dem::NlgsParameters::Order::random
+                     : order == "alternating" ? dem::NlgsParameters::Order::alternating
+                                              : dem::NlgsParameters::Order::fixed;
     p.solver.seed           = f.get_integer("Solver/Seed");
     p.gap_tolerance         = f.get_checked("Solver/Gap tolerance", non_negative, "a fraction >= 0 of the smallest radius");
 

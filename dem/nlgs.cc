@@ -99,8 +99,10 @@ namespace tribo::dem
     report.converged   = false;
     for (unsigned int sweep = 1; sweep <= prm.max_iterations; ++sweep)
       {
-        if (prm.random_order)
+        if (prm.order == NlgsParameters::Order::random)
           std::shuffle(order.begin(), order.end(), rng);
+        else if (prm.order == NlgsParameters::Order::alternating && sweep > 1)
+          std::reverse(order.begin(), order.end());
         const bool check = (sweep % prm.check_interval == 0) || sweep == prm.max_iterations;
         double     sum_wrwr = 0, sum_wrr = 0, sum_dvdv = 0, sum_dvdvrr = 0, sum_dvor = 0;
         double     max_dvdv = 0, max_dvdvrr = 0, max_violation = 0;

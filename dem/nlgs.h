@@ -44,7 +44,17 @@ namespace tribo::dem
     double       relaxation     = 1.0; ///< omega: r <- omega r_law + (1 - omega) r_old
     unsigned int check_interval = 10;  ///< sweeps between convergence checks
     unsigned int max_iterations = 10000; ///< sweeps
-    bool         random_order   = false; ///< shuffle the contact order every sweep
+    /// Order of the local solves in a sweep: the detection order (cells by rows, bottom to
+    /// top), that order and its reverse in turn (a symmetric Gauss-Seidel: what the
+    /// bottom wall imposes climbs the layer in one forward sweep, what the loaded top
+    /// wall imposes comes down in one backward sweep), or shuffled every sweep.
+    enum class Order
+    {
+      fixed,
+      alternating,
+      random
+    };
+    Order        order          = Order::fixed;
     unsigned int seed           = 1;
     /// Extra criterion (0: off): also require, for every IQS contact, the gap
     /// violation theta h max(0, -(u_n + shift)) to be at most this, m. The norms
