@@ -22,11 +22,12 @@ namespace tribo::app
 #endif
     prm.enter_subsection("Simulation");
     prm.declare_entry("Scene", "shear",
-                      Selection("collision|shear|sph_slider|mlp_ordering|mlp_compression|mlp_beams"),
+                      Selection("collision|shear|sph_slider|sph_plate|mlp_ordering|mlp_compression|mlp_beams"),
                       "What to simulate: 'collision' (two discs, Cao et al. 2011 Fig. 8); "
                       "'shear' (the third-body shear cell of Cao et al. 2011: a periodic layer of discs "
                       "compacted, then sheared, between two rough walls); 'sph_slider' (the SPH "
-                      "slider on a substrate of Maveyraud et al. 1999, subsection SPH slider); "
+                      "slider on a substrate of Maveyraud et al. 1999, subsection SPH slider); 'sph_plate' (the "
+                      "SPH cantilever-plate check, subsection SPH plate); "
                       "'mlp_ordering', 'mlp_compression', 'mlp_beams' (the movable-lattice-particle "
                       "scenes of Popov and Filippov 2006, subsection MLP).");
     prm.declare_entry("Time step", "1e-9", Double(), "Time step h, s (> 0).");

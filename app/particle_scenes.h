@@ -23,6 +23,9 @@ namespace tribo::app
 #ifdef TRIBO_WITH_SPH_SCENES
   /// Declare the subsections of the SPH scenes (app/scene_sph_slider.cc).
   void declare_sph_scene_parameters(dealii::ParameterHandler &prm);
+  /// Read and check an SPH scene's entries without running it (an InputError naming the
+  /// entry otherwise): `tribo check`, and `tribo run` before it writes anything.
+  void check_sph_scene(const ParameterFile &file);
   /// Run an SPH scene into @p dir; returns the exit code (as run_case()).
   int run_sph_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o);
 #endif
@@ -30,6 +33,10 @@ namespace tribo::app
 #ifdef TRIBO_WITH_MLP_SCENES
   /// Declare the subsections of the MLP scenes (app/scene_mlp.cc).
   void declare_mlp_scene_parameters(dealii::ParameterHandler &prm);
+  /// Read and check an MLP scene's entries and its time step without running it (an
+  /// InputError naming the entry otherwise): `tribo check`, and `tribo run` before it
+  /// writes anything.
+  void check_mlp_scene(const ParameterFile &file);
   /// Run an MLP scene into @p dir; returns the exit code (as run_case()).
   int run_mlp_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o);
 #endif

@@ -36,34 +36,6 @@ namespace tribo::app
       "nlgs_converged", "epsilon", "max_overlap", "kinetic_energy", "power_external",
       "power_free", "power_contacts"};
 
-    /// Undo ParameterHandler's name mangling ("_20" for a blank, ...).
-    std::string demangle(const std::string &s)
-    {
-      std::string out;
-      for (std::size_t i = 0; i < s.size(); ++i)
-        if (s[i] == '_' && i + 2 < s.size() + 0 && std::isxdigit(s[i + 1]) && std::isxdigit(s[i + 2]))
-          {
-            out += static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16));
-            i += 2;
-          }
-        else
-          out += s[i];
-      return out;
-    }
-
-    /// Every resolved entry as "Subsection/Entry" -> value.
-    void collect(const boost::property_tree::ptree &tree, const std::string &prefix,
-                 std::map<std::string, std::string> &out)
-    {
-      for (const auto &[key, child] : tree)
-        {
-          if (child.get_optional<std::string>("value"))
-            out[prefix + demangle(key)] = child.get<std::string>("value");
-          else if (!child.empty())
-            collect(child, prefix + demangle(key) + "/", out);
-        }
-    }
-
     void write_fields(FieldWriter &writer, double t, const dem::ParticleSystem &s,
                       const dem::MoreauJean &mj, double h, const Scene &scene)
     {
@@ -164,12 +136,12 @@ namespace tribo::app
        << "# Copy this file, keep the entries you change.\n";
     for (const auto &[section, entries] : tree)
       {
-        os << "\nsubsection " << demangle(section) << "\n";
+        os << "\nsubsection " << demangle_parameter_name(section) << "\n";
         for (const auto &[name, entry] : entries)
           {
             os << "  # " << entry.get<std::string>("documentation") << "\n"
                << "  # Allowed: " << entry.get<std::string>("pattern_description") << "\n"
-               << "  set " << demangle(name) << " = " << entry.get<std::string>("default_value")
+               << "  set " << demangle_parameter_name(name) << " = " << entry.get<std::string>("default_value")
                << "\n\n";
           }
         os << "end\n";
@@ -190,11 +162,17 @@ namespace tribo::app
     if (is_sph_scene(p.scene))
       throw InputError(o.case_file + ": Simulation/Scene = " + p.scene +
                        " is not in this build (the SPH scenes need TRIBO_WITH_SPH=ON)");
+#else
+    if (is_sph_scene(p.scene))
+      check_sph_scene(file);
 #endif
 #ifndef TRIBO_WITH_MLP_SCENES
     if (is_mlp_scene(p.scene))
       throw InputError(o.case_file + ": Simulation/Scene = " + p.scene +
                        " is not in this build (the MLP scenes need TRIBO_WITH_MLP=ON)");
+#else
+    if (is_mlp_scene(p.scene))
+      check_mlp_scene(file);
 #endif
     if (o.check_only)
       {
@@ -219,15 +197,7 @@ namespace tribo::app
                           : std::string(" (none was written: Output/Checkpoint interval and "
                                         "Checkpoint step interval were 0, or the run stopped "
                                         "before the first one)")));
-    std::map<std::string, std::string> resolved;
-    {
-      std::ostringstream os;
-      prm.print_parameters(os, dealii::ParameterHandler::JSON);
-      boost::property_tree::ptree tree;
-      std::istringstream          is(os.str());
-      boost::property_tree::read_json(is, tree);
-      collect(tree, "", resolved);
-    }
+    const std::map<std::string, std::string> resolved = file.resolved();
     // A resumption is checked before anything is written: a refused one changes nothing.
     std::string changes;
     if (resuming)

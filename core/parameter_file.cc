@@ -4,6 +4,11 @@
 
 #include <deal.II/base/exceptions.h>
 
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
+
+#include <cctype>
+
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -224,5 +229,43 @@ namespace tribo
   {
     throw InputError(where(path) + ": entry '" + path + "' = '" + get(path) + "': expected " +
                      expected);
+  }
+  std::string demangle_parameter_name(const std::string &s)
+  {
+    std::string out;
+    for (std::size_t i = 0; i < s.size(); ++i)
+      if (s[i] == '_' && i + 2 < s.size() && std::isxdigit(s[i + 1]) && std::isxdigit(s[i + 2]))
+        {
+          out += static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16));
+          i += 2;
+        }
+      else
+        out += s[i];
+    return out;
+  }
+
+  namespace
+  {
+    void collect(const boost::property_tree::ptree &tree, const std::string &prefix,
+                 std::map<std::string, std::string> &out)
+    {
+      for (const auto &[key, child] : tree)
+        if (child.get_optional<std::string>("value"))
+          out[prefix + demangle_parameter_name(key)] = child.get<std::string>("value");
+        else if (!child.empty())
+          collect(child, prefix + demangle_parameter_name(key) + "/", out);
+    }
+  } // namespace
+
+  std::map<std::string, std::string> ParameterFile::resolved() const
+  {
+    std::ostringstream os;
+    prm.print_parameters(os, dealii::ParameterHandler::JSON);
+    boost::property_tree::ptree tree;
+    std::istringstream          is(os.str());
+    boost::property_tree::read_json(is, tree);
+    std::map<std::string, std::string> out;
+    collect(tree, "", out);
+    return out;
   }
 } // namespace tribo

@@ -10,6 +10,9 @@
 
 namespace tribo
 {
+  /// Undo ParameterHandler's name mangling in its JSON and XML output ("_20" for a blank, ...).
+  std::string demangle_parameter_name(const std::string &s);
+
   /// A parsed case file on top of a ParameterHandler whose entries are already
   /// declared. Entries are addressed by path, "Subsection/Entry" (nested
   /// subsections separated by '/').
@@ -52,7 +55,10 @@ namespace tribo
     const std::string &filename() const { return file; }
     /// The file exactly as read.
     const std::string &original_text() const { return text; }
-    dealii::ParameterHandler &handler() { return prm; }
+    dealii::ParameterHandler       &handler() { return prm; }
+    const dealii::ParameterHandler &handler() const { return prm; }
+    /// Every entry as used (file, then set(), then defaults): "Subsection/Entry" -> value.
+    std::map<std::string, std::string> resolved() const;
 
   private:
     static std::vector<std::string> split_path(const std::string &path);

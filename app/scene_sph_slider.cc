@@ -1,0 +1,1251 @@
+// The SPH scenes (app/particle_scenes.h): the slider block on a substrate of Maveyraud,
+// Benz, Ouillon, Sornette and Sornette (1999) and the clamped cantilever plate used to
+// validate the elastic solver (Gray, Monaghan and Swift 2001).
+//
+// SI units. The vertical axis is the last one (y in 2D, z in 3D); in 2D (plane strain)
+// forces are per metre of depth (N/m) and masses kg/m. Boundary forces are those of the
+// substrate on the block, upward (repulsive) positive.
+#include "app/particle_scenes.h"
+
+#include "core/errors.h"
+#include "core/output.h"
+#include "core/run_control.h"
+#include "sph/lattice.h"
+#include "sph/solver.h"
+
+#include <deal.II/base/data_out_base.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+namespace tribo::app
+{
+  namespace
+  {
+    namespace fs = std::filesystem;
+    using dealii::Patterns::Anything;
+    using dealii::Patterns::Bool;
+    using dealii::Patterns::Double;
+    using dealii::Patterns::Integer;
+    using dealii::Patterns::Selection;
+    using sph::Tensor;
+
+    const std::string slider_section = "SPH slider";
+    const std::string plate_section  = "SPH plate";
+
+    /// Reads entries through a ParameterFile and keeps every value read, keyed by its
+    /// path, for the "parameters" group of results.h5.
+    class EntryReader
+    {
+    public:
+      explicit EntryReader(const ParameterFile &f) : file(f) {}
+      /// The value of @p path as text.
+      std::string text(const std::string &path)
+      {
+        return read[path] = file.get(path);
+      }
+      /// A number satisfying @p ok, else InputError "FILE:LINE: entry ... expected @p expected".
+      template <typename Check>
+      double number(const std::string &path, Check ok, const std::string &expected)
+      {
+        read[path] = file.get(path);
+        return file.get_checked(path, ok, expected);
+      }
+      /// An integer >= @p lowest, else InputError naming the entry.
+      long integer(const std::string &path, long lowest, const std::string &expected)
+      {
+        read[path]   = file.get(path);
+        const long v = file.get_integer(path);
+        if (v < lowest)
+          file.fail(path, expected);
+        return v;
+      }
+      /// Three lengths "Lx, Ly, Lz" in m, each > 0.
+      std::array<double, 3> lengths(const std::string &path)
+      {
+        const std::string  value = text(path);
+        std::istringstream is(value);
+        std::array<double, 3> out{};
+        std::string           item;
+        unsigned int          n = 0;
+        while (std::getline(is, item, ','))
+          {
+            std::size_t used = 0;
+            double      v    = 0;
+            try
+              {
+                v = std::stod(item, &used);
+              }
+            catch (const std::exception &)
+              {
+                file.fail(path, "three positive lengths in m, \"Lx, Ly, Lz\" (z vertical)");
+              }
+            if (n >= 3 || !(v > 0) || item.find_first_not_of(" \t", used) != std::string::npos)
+              file.fail(path, "three positive lengths in m, \"Lx, Ly, Lz\" (z vertical)");
+            out[n++] = v;
+          }
+        if (n != 3)
+          file.fail(path, "three positive lengths in m, \"Lx, Ly, Lz\" (z vertical)");
+        return out;
+      }
+      /// Throws InputError "FILE:LINE: entry 'path' = 'value': expected @p expected".
+      [[noreturn]] void fail(const std::string &path, const std::string &expected) const
+      {
+        file.fail(path, expected);
+      }
+      std::map<std::string, std::string> read;
+
+    private:
+      const ParameterFile &file;
+    };
+
+    auto positive     = [](double v) { return v > 0; };
+    auto non_negative = [](double v) { return v >= 0; };
+
+    /// Surfaces of the slider experiment (paper's sections 3 and 4).
+    enum class Surface
+    {
+      periodic,       ///< both lattices aligned and of the same spacing
+      tilted,         ///< the block's lattice rotated in the x-vertical plane
+      incommensurate, ///< block spacing = ratio * substrate spacing
+      step,           ///< one-particle step on the substrate beyond x_step
+      holes,          ///< a fraction of the substrate's top particles removed
+      random_heights, ///< substrate top particles moved vertically, uniform in +/- dz/2
+      fractal         ///< self-affine substrate top of fractal dimension D_f, rms dz
+    };
+
+    /// Everything the slider scene reads from its subsection.
+    struct SliderParameters
+    {
+      unsigned int          dim = 3;
+      sph::Material         material;
+      sph::LatticeType      lattice = sph::LatticeType::cubic;
+      double                spacing = 0, smoothing_ratio = 1.2;
+      std::array<double, 3> block{}, substrate{};
+      bool                  periodic = true;
+      double                pressure = 0, tau = 0, velocity = 0, slide_start = 0, end_time = 0;
+      double                gamma = 0, settling_gamma = 0;
+      bool                  damping_to_sliding_velocity = true;
+      unsigned int          driven_layers = 1;
+      double                alpha = 1, beta = 0.1, courant = 0.3, dt_min = 0;
+      double                stiffness_factor = 1, range_ratio = 1;
+      Surface               surface = Surface::periodic;
+      double                angle = 0, ratio = 1, hole_fraction = 0, dz = 0, fractal_dimension = 2.5;
+      double                step_position = 0;
+      std::uint64_t         seed = 1;
+      unsigned int          regions = 4;
+      double                statistics_interval = 0, field_interval = 0, averaging_fraction = 0.5;
+    };
+
+    /// Parameters of the cantilever plate (2D plane strain).
+    struct PlateParameters
+    {
+      sph::Material material;
+      double        length = 0, thickness = 0, spacing = 0, smoothing_ratio = 1.2, tip_velocity = 0;
+      double        alpha = 1, beta = 0.1, courant = 0.3, dt_min = 0, end_time = 0;
+      double        statistics_interval = 0, field_interval = 0;
+    };
+
+    /// Young's modulus E = 9 K G/(3 K + G) (Pa) and Poisson ratio
+    /// nu = (3 K - 2 G)/(2 (3 K + G)) of a material's small-strain moduli (K = A for Tillotson).
+    std::pair<double, double> young_and_poisson(const sph::Material &m)
+    {
+      const double K = m.bulk_modulus, G = m.shear_modulus;
+      return {9 * K * G / (3 * K + G), (3 * K - 2 * G) / (2 * (3 * K + G))};
+    }
+
+    /// The material named granite or basalt (pattern-checked).
+    sph::Material material_named(const std::string &name)
+    {
+      return name == "basalt" ? sph::Material::basalt() : sph::Material::granite();
+    }
+
+    /// Reads and checks the subsection "SPH slider" (and Simulation/End time).
+    SliderParameters read_slider(EntryReader &r)
+    {
+      const std::string s = slider_section + "/";
+      SliderParameters  p;
+      p.dim      = static_cast<unsigned int>(std::stoi(r.text(s + "Dimension")));
+      p.material = material_named(r.text(s + "Material"));
+      p.lattice  = r.text(s + "Lattice") == "hcp" ? sph::LatticeType::hexagonal : sph::LatticeType::cubic;
+      p.spacing  = r.number(s + "Particle spacing", positive, "a positive particle spacing in m");
+      p.smoothing_ratio = r.number(s + "Smoothing length ratio", [](double v) { return v >= 1 && v <= 2; },
+                                   "a ratio h/a in [1, 2]");
+      p.block     = r.lengths(s + "Block size");
+      p.substrate = r.lengths(s + "Substrate size");
+      p.periodic  = r.text(s + "Periodic") == "true";
+      p.pressure  = r.number(s + "Pressure", positive, "a positive pressure in Pa");
+      p.tau       = r.number(s + "Pressure ramp time", positive, "a positive ramp time tau in s");
+      p.velocity  = r.number(s + "Sliding velocity", non_negative, "a sliding velocity >= 0 in m/s");
+      p.slide_start = r.number(s + "Slide start", non_negative, "a start time >= 0 in s");
+      p.end_time = r.number("Simulation/End time", positive, "a positive end time in s");
+      p.gamma    = r.number(s + "Gamma", non_negative, "a damping rate gamma >= 0 in 1/s");
+      p.settling_gamma = r.number(s + "Settling gamma", non_negative, "a damping rate >= 0 in 1/s");
+      p.damping_to_sliding_velocity = r.text(s + "Damping reference") == "sliding velocity";
+      p.driven_layers = static_cast<unsigned int>(r.integer(s + "Driven layers", 1, "an integer >= 1"));
+      p.alpha   = r.number(s + "Artificial viscosity alpha", non_negative, "alpha >= 0");
+      p.beta    = r.number(s + "Artificial viscosity beta", non_negative, "beta >= 0");
+      p.courant = r.number(s + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
+      p.dt_min  = r.number(s + "Step floor", positive, "a positive step floor in s");
+      p.stiffness_factor = r.number(s + "Boundary stiffness factor", positive, "a positive factor");
+      p.range_ratio = r.number(s + "Boundary range ratio", [](double v) { return v > 0 && v < 2; },
+                               "a ratio d/a in (0, 2)");
+      const std::string surface = r.text(s + "Surface");
+      const std::map<std::string, Surface> surfaces = {
+        {"periodic", Surface::periodic}, {"tilted", Surface::tilted},
+        {"incommensurate", Surface::incommensurate}, {"step", Surface::step},
+        {"holes", Surface::holes}, {"random heights", Surface::random_heights},
+        {"fractal", Surface::fractal}};
+      p.surface = surfaces.at(surface);
+      p.angle   = r.number(s + "Tilt angle", [](double v) { return v >= 0 && v <= 45; },
+                           "an angle in degrees in [0, 45]") * M_PI / 180;
+      p.ratio   = r.number(s + "Mesh ratio", positive, "a positive ratio (golden mean 1.618...)");
+      p.hole_fraction = r.number(s + "Hole fraction", [](double v) { return v >= 0 && v < 1; },
+                                 "a fraction in [0, 1)");
+      p.dz = r.number(s + "Roughness amplitude", non_negative, "a height >= 0 in m");
+      p.fractal_dimension = r.number(s + "Fractal dimension", [&](double v) {
+        return p.surface != Surface::fractal || (v > p.dim - 1.0 && v < p.dim);
+      }, "D_f in (dim - 1, dim) for Surface = fractal");
+      p.step_position = r.number(s + "Step position", non_negative, "a position >= 0 in m");
+      p.seed    = static_cast<std::uint64_t>(r.integer(s + "Seed", 0, "an integer >= 0"));
+      p.regions = static_cast<unsigned int>(r.integer(s + "Local friction regions", 1, "an integer >= 1"));
+      p.statistics_interval = r.number(s + "Statistics interval", positive, "a positive interval in s");
+      p.field_interval = r.number(s + "Field interval", non_negative, "an interval >= 0 in s (0: first and last)");
+      p.averaging_fraction = r.number(s + "Averaging fraction", [](double v) { return v > 0 && v <= 1; },
+                                      "a fraction in (0, 1]");
+      if (p.slide_start >= p.end_time)
+        r.fail(s + "Slide start", "a start time below Simulation/End time = " + to_text(p.end_time) + " s");
+      if (p.block[0] > p.substrate[0] || (p.dim == 3 && p.block[1] > p.substrate[1]))
+        r.fail(s + "Block size", "a block no wider than the substrate");
+      if (p.surface == Surface::incommensurate && p.ratio == 1)
+        r.fail(s + "Mesh ratio", "a ratio != 1 for Surface = incommensurate");
+      return p;
+    }
+
+    /// Reads and checks the subsection "SPH plate".
+    PlateParameters read_plate(EntryReader &r)
+    {
+      const std::string s = plate_section + "/";
+      PlateParameters   p;
+      p.material  = material_named(r.text(s + "Material"));
+      p.length    = r.number(s + "Length", positive, "a positive length in m");
+      p.thickness = r.number(s + "Thickness", positive, "a positive thickness in m");
+      p.spacing   = r.number(s + "Particle spacing", positive, "a positive particle spacing in m");
+      p.smoothing_ratio = r.number(s + "Smoothing length ratio", [](double v) { return v >= 1 && v <= 2; },
+                                   "a ratio h/a in [1, 2]");
+      p.tip_velocity = r.number(s + "Tip velocity", positive, "a positive velocity in m/s");
+      p.alpha   = r.number(s + "Artificial viscosity alpha", non_negative, "alpha >= 0");
+      p.beta    = r.number(s + "Artificial viscosity beta", non_negative, "beta >= 0");
+      p.courant = r.number(s + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
+      p.dt_min  = r.number(s + "Step floor", positive, "a positive step floor in s");
+      p.end_time = r.number("Simulation/End time", positive, "a positive end time in s");
+      p.statistics_interval = r.number(s + "Statistics interval", positive, "a positive interval in s");
+      p.field_interval = r.number(s + "Field interval", non_negative, "an interval >= 0 in s");
+      if (p.thickness < 3 * p.spacing || p.length < 3 * p.thickness)
+        r.fail(s + "Thickness", "at least 3 particle spacings and at most a third of the length");
+      return p;
+    }
+
+    /// A vector along the vertical (last) axis of length @p value.
+    template <int dim>
+    Tensor<1, dim> vertical(double value)
+    {
+      Tensor<1, dim> t;
+      t[dim - 1] = value;
+      return t;
+    }
+
+    /// VTU text of the particles: one vertex per particle with velocity (m/s), boundary
+    /// force (N, N/m in 2D; from the last rate evaluation), pressure P (Pa, compression
+    /// positive), Cauchy stress sigma = -P I + S (Pa, tension positive; in 2D also the
+    /// plane-strain sigma_zz = -P + S_zz, S_zz = -(S_xx + S_yy)), density (kg/m^3),
+    /// specific internal energy (J/kg) and body id.
+    template <int dim>
+    std::string particle_vtu(const sph::Solver<dim> &solver)
+    {
+      const auto        &s  = solver.state;
+      const auto        &k  = solver.last_rates();
+      const unsigned int n_stress = dim == 2 ? 4 : 6;
+      const unsigned int n_comp   = 2 * dim + 1 + n_stress + 3;
+      std::vector<dealii::DataOutBase::Patch<0, dim>> patches(s.size());
+      for (unsigned int i = 0; i < s.size(); ++i)
+        {
+          auto &p = patches[i];
+          for (unsigned int d = 0; d < dim; ++d)
+            p.vertices[0][d] = s.x[i][d];
+          p.patch_index = i;
+          p.data.reinit(n_comp, 1);
+          const double P = solver.materials()[s.material[i]].evaluate(s.rho[i], s.e[i]).pressure;
+          unsigned int c = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            p.data(c++, 0) = s.v[i][d];
+          for (unsigned int d = 0; d < dim; ++d)
+            p.data(c++, 0) = k.boundary_force.size() == s.size() ? k.boundary_force[i][d] : 0.0;
+          p.data(c++, 0) = P;
+          for (unsigned int a = 0; a < dim; ++a)
+            p.data(c++, 0) = s.S[i][a][a] - P;
+          if (dim == 2)
+            p.data(c++, 0) = -(s.S[i][0][0] + s.S[i][1][1]) - P;
+          for (unsigned int a = 0; a < dim; ++a)
+            for (unsigned int b = a + 1; b < dim; ++b)
+              p.data(c++, 0) = s.S[i][a][b];
+          p.data(c++, 0) = s.rho[i];
+          p.data(c++, 0) = s.e[i];
+          p.data(c++, 0) = s.body[i];
+        }
+      std::vector<std::string> names(dim, "velocity");
+      names.insert(names.end(), dim, "boundary_force");
+      names.push_back("pressure");
+      const std::vector<std::string> stress =
+        dim == 2 ? std::vector<std::string>{"sigma_xx", "sigma_yy", "sigma_zz", "sigma_xy"}
+                 : std::vector<std::string>{"sigma_xx", "sigma_yy", "sigma_zz", "sigma_xy", "sigma_xz", "sigma_yz"};
+      names.insert(names.end(), stress.begin(), stress.end());
+      for (const char *n : {"density", "internal_energy", "body"})
+        names.push_back(n);
+      using DCI = dealii::DataComponentInterpretation::DataComponentInterpretation;
+      const std::vector<std::tuple<unsigned int, unsigned int, std::string, DCI>> vectors = {
+        {0, dim - 1, "velocity", dealii::DataComponentInterpretation::component_is_part_of_vector},
+        {dim, 2 * dim - 1, "boundary_force", dealii::DataComponentInterpretation::component_is_part_of_vector}};
+      dealii::DataOutBase::VtkFlags flags;
+      flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
+      std::ostringstream os;
+      dealii::DataOutBase::write_vtu(patches, names, vectors, flags, os);
+      return os.str();
+    }
+
+    /// What a scene adds to the common explicit loop: its columns, its per-step
+    /// bookkeeping, its rows and its summary.
+    template <int dim>
+    class Experiment
+    {
+    public:
+      virtual ~Experiment() = default;
+      /// Columns of statistics.csv after "time", "step", "dt".
+      virtual std::vector<std::string> columns() const = 0;
+      /// Largest step allowed now (to land on an event time), s.
+      virtual double step_limit(const sph::Solver<dim> &) const { return std::numeric_limits<double>::infinity(); }
+      /// Before each step (state at the start of the step).
+      virtual void before_step(sph::Solver<dim> &solver) = 0;
+      /// After a step of length @p dt.
+      virtual void after_step(sph::Solver<dim> &solver, double dt) = 0;
+      /// The scene's values of a statistics row; resets the interval averages.
+      virtual std::vector<double> row(const sph::Solver<dim> &solver) = 0;
+      /// Results of the run for summary.json "results" from the statistics.
+      virtual void summarize(const TimeSeries &stats, double t_end, JsonObject &results) const = 0;
+    };
+
+    /// Output settings of the explicit loop.
+    struct LoopSettings
+    {
+      std::string scene;
+      double      end_time = 0, statistics_interval = 0, field_interval = 0;
+    };
+
+    /// The explicit time loop shared by the SPH scenes: RK2 steps until the end time,
+    /// statistics rows every statistics interval of simulated time, VTU snapshots
+    /// fields/particles_NNNNN.vtu indexed in fields/particles.pvd, SIGINT/SIGTERM (status
+    /// "interrupted", exit 128 + N) and RunError (status "failed", exit 1), each keeping
+    /// the outputs of the steps done. Returns the exit code.
+    template <int dim>
+    int run_loop(sph::Solver<dim> &solver, Experiment<dim> &exp, const LoopSettings &ls,
+                 const std::map<std::string, std::string> &parameters, JsonObject summary,
+                 const std::string &dir, Log &log, const RunOptions &o)
+    {
+      install_stop_handlers();
+      const auto wall_start = std::chrono::steady_clock::now();
+      std::vector<std::string> columns = {"time", "step", "dt"};
+      for (const auto &c : exp.columns())
+        columns.push_back(c);
+      TimeSeries  stats(columns);
+      FieldWriter fields((fs::path(dir) / "fields").string());
+      unsigned int n_fields = 0;
+      const auto snapshot = [&]() {
+        char name[40];
+        std::snprintf(name, sizeof name, "particles_%05u.vtu", n_fields++);
+        atomic_write((fs::path(dir) / "fields" / name).string(), particle_vtu(solver));
+        fields.index("particles", solver.time, name);
+      };
+      unsigned long step = 0;
+      double        dt = 0, dt_lo = std::numeric_limits<double>::infinity(), dt_hi = 0;
+      const auto    add_row = [&]() {
+        std::vector<double> row = {solver.time, double(step), dt};
+        for (double v : exp.row(solver))
+          row.push_back(v);
+        stats.add_row(row);
+      };
+      std::string status = "complete", failure;
+      snapshot();
+      add_row();
+      double       next_row   = ls.statistics_interval;
+      double       next_field = ls.field_interval > 0 ? ls.field_interval : 2 * ls.end_time;
+      ProgressLine progress(ls.end_time, !o.quiet);
+      auto         last_flush = std::chrono::steady_clock::now();
+      try
+        {
+          while (solver.time < ls.end_time * (1 - 1e-12))
+            {
+              if (stop_requested())
+                {
+                  status = "interrupted";
+                  break;
+                }
+              exp.before_step(solver);
+              dt = solver.step(std::min(ls.end_time - solver.time, exp.step_limit(solver)));
+              ++step;
+              dt_lo = std::min(dt_lo, dt);
+              dt_hi = std::max(dt_hi, dt);
+              exp.after_step(solver, dt);
+              if (solver.time >= next_row * (1 - 1e-12))
+                {
+                  add_row();
+                  while (next_row <= solver.time * (1 + 1e-12))
+                    next_row += ls.statistics_interval;
+                }
+              if (solver.time >= next_field * (1 - 1e-12) && solver.time < ls.end_time * (1 - 1e-12))
+                {
+                  snapshot();
+                  while (next_field <= solver.time * (1 + 1e-12))
+                    next_field += ls.field_interval;
+                }
+              progress.update(solver.time, step);
+              const auto now = std::chrono::steady_clock::now();
+              if (std::chrono::duration<double>(now - last_flush).count() > 10)
+                {
+                  atomic_write((fs::path(dir) / "statistics.csv").string(), stats.to_csv());
+                  last_flush = now;
+                }
+            }
+        }
+      catch (const RunError &e)
+        {
+          status  = "failed";
+          failure = e.what();
+        }
+      progress.finish();
+      if (stats.rows().back()[1] != double(step))
+        add_row();
+      snapshot();
+
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      summary.set("status", status);
+      if (!failure.empty())
+        summary.set("error", failure);
+      if (status == "interrupted")
+        summary.set("signal", long(stop_requested()));
+      summary.set("scene", ls.scene);
+      summary.set("dimension", long(dim));
+      summary.set("steps", long(step));
+      summary.set("simulated_time", solver.time);
+      summary.set("end_time", ls.end_time);
+      summary.set("wall_time", wall);
+      summary.set("dt_min", step ? dt_lo : 0.0);
+      summary.set("dt_max", dt_hi);
+      summary.set("last_step_limiter", solver.last_limiter());
+      summary.set("n_particles", long(solver.state.size()));
+      summary.set("n_field_snapshots", long(n_fields));
+      JsonObject results;
+      exp.summarize(stats, solver.time, results);
+      summary.set("results", results);
+
+      const std::map<std::string, double> scalars = {
+        {"steps", double(step)}, {"simulated_time", solver.time}, {"wall_time", wall},
+        {"dt_min", step ? dt_lo : 0.0}, {"dt_max", dt_hi}, {"complete", status == "complete" ? 1.0 : 0.0}};
+      atomic_write((fs::path(dir) / "statistics.csv").string(), stats.to_csv());
+      write_results_h5((fs::path(dir) / "results.h5").string(), stats, {}, parameters, scalars);
+      atomic_write((fs::path(dir) / "summary.json").string(), summary.to_string());
+
+      std::ostringstream os;
+      os << "status " << status << ": " << step << " steps to t = " << solver.time << " s in " << wall
+         << " s; step " << (step ? dt_lo : 0.0) << " .. " << dt_hi << " s";
+      log(os.str());
+      if (status == "failed")
+        {
+          log("error: " + failure);
+          return exit_run_error;
+        }
+      if (status == "interrupted")
+        {
+          log("interrupted by signal " + std::to_string(stop_requested()) +
+              ": outputs hold the steps done so far");
+          return 128 + stop_requested();
+        }
+      return exit_ok;
+    }
+
+    /// Mean of @p v over indices in @p rows.
+    double mean_of(const std::vector<double> &v, const std::vector<std::size_t> &rows)
+    {
+      double s = 0;
+      for (auto r : rows)
+        s += v[r];
+      return rows.empty() ? 0.0 : s / rows.size();
+    }
+
+    /// Standard deviation (population) of @p v over indices in @p rows.
+    double std_of(const std::vector<double> &v, const std::vector<std::size_t> &rows)
+    {
+      const double m = mean_of(v, rows);
+      double       s = 0;
+      for (auto r : rows)
+        s += (v[r] - m) * (v[r] - m);
+      return rows.empty() ? 0.0 : std::sqrt(s / rows.size());
+    }
+
+    // ------------------------------------------------------------------------------------
+    // The slider
+
+    /// The slider experiment: a block (body 1) pressed on a substrate (body 0) by a
+    /// pressure P on its top layer ramped as P (1 - exp(-t/tau)), the substrate's bottom
+    /// layer fixed; from the slide start the top layer(s) of the block move horizontally
+    /// at V (vertical motion free) and the friction on the block's contact layer is
+    /// measured: mu = -F_x/F_n sign(V) with F = sum of the boundary forces of the substrate
+    /// on the block's first layer (F_n upward positive; mu > 0 is a drag; the paper's
+    /// mu_l has the opposite sign).
+    template <int dim>
+    class Slider : public Experiment<dim>
+    {
+    public:
+      Slider(const SliderParameters &p, sph::Solver<dim> &solver, Log &log)
+        : p(p)
+      {
+        build(solver, log);
+      }
+
+      /// Load area A (m^2, m in 2D) and the nominal normal force P A (N, N/m in 2D).
+      double area() const { return load_area; }
+      unsigned int n_block() const { return n_b; }
+      unsigned int n_substrate() const { return n_s; }
+
+      std::vector<std::string> columns() const override
+      {
+        std::vector<std::string> c = {
+          "force_x", "force_normal", "mu", "normal_force_ratio", "drive_force_x", "block_dx",
+          "block_dz", "block_vx", "block_vz", "kinetic_energy_block", "kinetic_energy_substrate",
+          "internal_energy", "work_pressure", "work_drive", "energy_residual"};
+        for (unsigned int r = 0; r < p.regions; ++r)
+          c.push_back("mu_region_" + std::to_string(r));
+        return c;
+      }
+
+      /// Lands on the slide start.
+      double step_limit(const sph::Solver<dim> &solver) const override
+      {
+        if (sliding || solver.time >= p.slide_start)
+          return std::numeric_limits<double>::infinity();
+        return p.slide_start - solver.time;
+      }
+
+      /// Starts sliding at the slide start; keeps the loaded layer's velocities and the
+      /// block's positions at the start of the step (for the pressure's work, the drive
+      /// and the unwrapped displacements).
+      void before_step(sph::Solver<dim> &solver) override
+      {
+        if (!sliding && solver.time >= p.slide_start * (1 - 1e-12))
+          start_sliding(solver);
+        const auto &s = solver.state;
+        for (unsigned int q = 0; q < top.size(); ++q)
+          v_top[q] = s.v[top[q]];
+        for (unsigned int q = 0; q < block.size(); ++q)
+          x_block[q] = s.x[block[q]];
+      }
+
+      /// Work of the pressure over the step, W += F_i(t + dt/2) . (v_i + v_i')/2 dt;
+      /// horizontal driving of the driven particles: v_x <- V and x <- x_old + V dt (the
+      /// vertical motion stays the step's), whose impulse sum m (V - v_x) (N s) is the drive
+      /// force times dt and whose work is V times it;
+      /// interval sums of the contact forces (midpoint rates) weighted by dt.
+      void after_step(sph::Solver<dim> &solver, double dt) override
+      {
+        auto        &s    = solver.state;
+        const double ramp = 1 - std::exp(-(solver.time - 0.5 * dt) / p.tau);
+        for (unsigned int q = 0; q < top.size(); ++q)
+          work_pressure += ramp * load_per_particle * 0.5 * (v_top[q][dim - 1] + s.v[top[q]][dim - 1]) * dt;
+        if (sliding)
+          {
+            const double period = solver.parameters().period;
+            double       impulse = 0;
+            for (unsigned int i : driven)
+              {
+                impulse += s.mass[i] * (p.velocity - s.v[i][0]);
+                s.v[i][0] = p.velocity;
+                // Kinematic: x advances by exactly V dt, whatever the step's forces did.
+                double &x = s.x[i][0];
+                x = x_block[i - first_block][0] + p.velocity * dt;
+                if (period > 0)
+                  x -= period * std::floor(x / period);
+              }
+            drive_impulse += impulse;
+            work_drive += p.velocity * impulse;
+          }
+        const auto &bf = solver.last_rates().boundary_force;
+        for (unsigned int q = 0; q < contact.size(); ++q)
+          {
+            const unsigned int i = contact[q];
+            sum_fx[region[q]] += bf[i][0] * dt;
+            sum_fn[region[q]] += bf[i][dim - 1] * dt;
+          }
+        for (unsigned int q = 0; q < block.size(); ++q)
+          displacement[q] += solver.neighbours().separation(s.x[block[q]], x_block[q]);
+        interval += dt;
+      }
+
+      /// The slider's columns (see columns()): interval means of the contact forces and
+      /// the drive, centre-of-mass motion, energies; resets the interval sums.
+      std::vector<double> row(const sph::Solver<dim> &solver) override
+      {
+        const auto &s = solver.state;
+        double      fx = 0, fn = 0;
+        for (unsigned int r = 0; r < p.regions; ++r)
+          {
+            fx += sum_fx[r];
+            fn += sum_fn[r];
+          }
+        const double w = interval > 0 ? 1 / interval : 0.0;
+        // At t = 0 (no interval yet) the instantaneous forces are 0 anyway.
+        const double sign = p.velocity >= 0 ? 1.0 : -1.0;
+        const auto   mu_of = [&](double x, double n) { return n > 0 ? -sign * x / n : 0.0; };
+        Tensor<1, dim> dx_cm, v_cm;
+        double         m_b = 0, ke_b = 0, ke_s = 0, e_int = 0;
+        for (unsigned int q = 0; q < block.size(); ++q)
+          {
+            const unsigned int i = block[q];
+            dx_cm += s.mass[i] * displacement[q];
+            v_cm += s.mass[i] * s.v[i];
+            m_b += s.mass[i];
+          }
+        for (unsigned int i = 0; i < s.size(); ++i)
+          {
+            (s.body[i] == 1 ? ke_b : ke_s) += 0.5 * s.mass[i] * s.v[i].norm_square();
+            e_int += s.mass[i] * s.e[i];
+          }
+        dx_cm /= m_b;
+        v_cm /= m_b;
+        const double ramp     = 1 - std::exp(-solver.time / p.tau);
+        const double residual = work_pressure + work_drive - (ke_b + ke_s) - e_int;
+        std::vector<double> r = {fx * w, fn * w, mu_of(fx, fn),
+                                 ramp > 0 ? fn * w / (p.pressure * load_area * ramp) : 0.0,
+                                 drive_impulse * w, dx_cm[0], dx_cm[dim - 1], v_cm[0], v_cm[dim - 1],
+                                 ke_b, ke_s, e_int, work_pressure, work_drive, residual};
+        for (unsigned int k = 0; k < p.regions; ++k)
+          r.push_back(mu_of(sum_fx[k], sum_fn[k]));
+        std::fill(sum_fx.begin(), sum_fx.end(), 0.0);
+        std::fill(sum_fn.begin(), sum_fn.end(), 0.0);
+        drive_impulse = 0;
+        interval      = 0;
+        return r;
+      }
+
+      /// The window: the last N whole lattice periods a/V of the sliding phase,
+      /// N = floor(f (t_e - t_s) V/a) (t_s slide start, t_e end of the run, f the averaging
+      /// fraction, a the substrate spacing), so that the climbs and descents over the
+      /// substrate's particles cancel; if N = 0, the last f (t_e - t_s). mu_mean = -sum(F_x)/sum(F_n) over it (rows are
+      /// interval means over equal times), mu_std the standard deviation of the rows' mu.
+      void summarize(const TimeSeries &stats, double t_end, JsonObject &res) const override
+      {
+        const auto   t       = stats.column("time");
+        const double sliding = std::max(0.0, t_end - p.slide_start);
+        const double period  = p.velocity > 0 ? p.spacing / p.velocity : 0.0;
+        const double whole   = period > 0 ? std::floor(p.averaging_fraction * sliding / period * (1 + 1e-9)) : 0.0;
+        const double t0      = t_end - (whole >= 1 ? whole * period : p.averaging_fraction * sliding);
+        std::vector<std::size_t> rows;
+        for (std::size_t r = 1; r < t.size(); ++r)
+          if (t[r] > t0 && t_end > p.slide_start)
+            rows.push_back(r);
+        const auto fx = stats.column("force_x"), fn = stats.column("force_normal");
+        const double sign = p.velocity >= 0 ? 1.0 : -1.0;
+        const double fn_mean = mean_of(fn, rows);
+        res.set("window_start", t0);
+        res.set("window_end", t_end);
+        res.set("window_rows", long(rows.size()));
+        res.set("window_lattice_periods", whole);
+        res.set("mu_mean", fn_mean > 0 ? -sign * mean_of(fx, rows) / fn_mean : 0.0);
+        res.set("mu_std", std_of(stats.column("mu"), rows));
+        res.set("mu_rows_mean", mean_of(stats.column("mu"), rows));
+        res.set("normal_force_mean", fn_mean);
+        res.set("tangential_force_mean", mean_of(fx, rows));
+        res.set("nominal_normal_force", p.pressure * load_area);
+        res.set("normal_force_ratio", fn_mean / (p.pressure * load_area));
+        res.set("drive_force_mean", mean_of(stats.column("drive_force_x"), rows));
+        res.set("block_vx_mean", mean_of(stats.column("block_vx"), rows));
+        for (unsigned int k = 0; k < p.regions; ++k)
+          res.set("mu_region_" + std::to_string(k) + "_mean",
+                  mean_of(stats.column("mu_region_" + std::to_string(k)), rows));
+        res.set("load_area", load_area);
+        res.set("pressure", p.pressure);
+        res.set("sliding_velocity", p.velocity);
+        res.set("gamma", p.gamma);
+        res.set("slide_start", p.slide_start);
+        res.set("sliding_distance", std::max(0.0, t_end - p.slide_start) * p.velocity);
+        res.set("n_block", long(n_b));
+        res.set("n_substrate", long(n_s));
+        res.set("n_contact_layer", long(contact.size()));
+        res.set("n_driven", long(driven.size()));
+        res.set("n_loaded", long(top.size()));
+      }
+
+    private:
+      /// Distance between horizontal layers of a lattice of spacing @p a (m).
+      double layer_spacing(double a) const
+      {
+        if (p.lattice == sph::LatticeType::cubic)
+          return a;
+        return dim == 2 ? a * std::sqrt(3.0) / 2 : a * std::sqrt(2.0 / 3.0);
+      }
+
+      /// Box of the lengths "Lx, Ly, Lz" (2D: Lx and Lz).
+      Tensor<1, dim> box(const std::array<double, 3> &l) const
+      {
+        Tensor<1, dim> b;
+        b[0]       = l[0];
+        b[dim - 1] = l[2];
+        if (dim == 3)
+          b[1] = l[1];
+        return b;
+      }
+
+      /// The substrate's points with the surface modifier applied to its top layer.
+      std::vector<Tensor<1, dim>> substrate_points(double a, Tensor<1, dim> &size) const
+      {
+        size = box(p.substrate);
+        if (p.periodic)
+          size[0] = std::max(3.0, std::round(size[0] / a)) * a;
+        auto         pts = sph::lattice_points<dim>(p.lattice, Tensor<1, dim>(), size, a);
+        const double tol = 0.25 * layer_spacing(a);
+        switch (p.surface)
+          {
+            case Surface::step:
+              sph::add_step(pts, p.step_position, layer_spacing(a), tol);
+              break;
+            case Surface::holes:
+              sph::random_holes(pts, p.hole_fraction, p.seed, tol);
+              break;
+            case Surface::random_heights:
+              sph::random_heights(pts, p.dz, p.seed, tol);
+              break;
+            case Surface::fractal:
+              sph::fractal_heights(pts, p.fractal_dimension, p.dz, size,
+                                   static_cast<unsigned int>(size[0] / a / 2), p.seed, tol);
+              break;
+            default:
+              break;
+          }
+        return pts;
+      }
+
+      /// The block's points (origin 0): a box lattice, or for Surface = tilted a lattice
+      /// rotated by the tilt angle about the box centre and cut to the box.
+      std::vector<Tensor<1, dim>> block_points(double a) const
+      {
+        const Tensor<1, dim> size = box(p.block);
+        if (p.surface != Surface::tilted)
+          return sph::lattice_points<dim>(p.lattice, Tensor<1, dim>(), size, a);
+        const double   diag = size.norm();
+        Tensor<1, dim> big_origin, big;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            big[d]        = d == 1 && dim == 3 ? size[d] : size[d] + 2 * diag;
+            big_origin[d] = d == 1 && dim == 3 ? 0 : -diag;
+          }
+        auto pts = sph::lattice_points<dim>(p.lattice, big_origin, big, a);
+        sph::tilt(pts, size / 2, p.angle);
+        std::vector<Tensor<1, dim>> kept;
+        for (const auto &x : pts)
+          {
+            bool in = true;
+            for (unsigned int d = 0; d < dim; ++d)
+              in = in && x[d] >= 0 && x[d] < size[d];
+            if (in)
+              kept.push_back(x);
+          }
+        return kept;
+      }
+
+      /// The block's rest position: shift = centre + o + z e_vertical where the horizontal
+      /// offset o (a grid of 8 per axis over one spacing @p a) lets the block sit lowest
+      /// with every block-substrate distance >= d, the range of f1 (the valleys of the
+      /// substrate, zero force). For a pair at horizontal distance rho < d the block's
+      /// particle may come down to z_j + sqrt(d^2 - rho^2); @p period > 0: x periodic.
+      Tensor<1, dim> placement(const std::vector<Tensor<1, dim>> &sub, const std::vector<Tensor<1, dim>> &blk,
+                               const Tensor<1, dim> &centre, double a, double period) const
+      {
+        const double d = p.range_ratio * a;
+        double       sub_top = -1e300, blk_bottom = 1e300;
+        for (const auto &x : sub)
+          sub_top = std::max(sub_top, x[dim - 1]);
+        for (const auto &x : blk)
+          blk_bottom = std::min(blk_bottom, x[dim - 1]);
+        std::vector<Tensor<1, dim>> near_sub, near_blk; // the layers that can touch
+        for (const auto &x : sub)
+          if (x[dim - 1] > sub_top - 2 * d)
+            near_sub.push_back(x);
+        for (const auto &x : blk)
+          if (x[dim - 1] < blk_bottom + 2 * d)
+            near_blk.push_back(x);
+        const unsigned int n_grid = 8;
+        Tensor<1, dim>     best;
+        best[dim - 1] = 1e300;
+        for (unsigned int gx = 0; gx < n_grid; ++gx)
+          for (unsigned int gy = 0; gy < (dim == 3 ? n_grid : 1U); ++gy)
+            {
+              Tensor<1, dim> shift = centre;
+              shift[0] += gx * a / n_grid;
+              if (dim == 3)
+                shift[1] += gy * a / n_grid;
+              // Lowest z such that the block's bottom is at z: max over the constraints.
+              double z = sub_top + d - blk_bottom - 2 * d;
+              for (const auto &xb : near_blk)
+                for (const auto &xs : near_sub)
+                  {
+                    Tensor<1, dim> r = xb + shift - xs;
+                    if (period > 0)
+                      r[0] -= period * std::nearbyint(r[0] / period);
+                    r[dim - 1] = 0;
+                    const double rho2 = r.norm_square();
+                    if (rho2 < d * d)
+                      z = std::max(z, xs[dim - 1] + std::sqrt(d * d - rho2) - xb[dim - 1]);
+                  }
+              if (z < best[dim - 1] - 1e-12 * a)
+                {
+                  best          = shift;
+                  best[dim - 1] = z;
+                }
+            }
+        return best;
+      }
+
+      /// Builds both bodies, the load, the fixed bottom, the boundary law, the damping
+      /// and the particle groups (top, driven, contact layer and its regions).
+      void build(sph::Solver<dim> &solver, Log &log)
+      {
+        const double a_s = p.spacing;
+        const double a_b = p.surface == Surface::incommensurate ? p.ratio * p.spacing : p.spacing;
+        Tensor<1, dim> sub_size;
+        const auto   sub = substrate_points(a_s, sub_size);
+        auto         blk = block_points(a_b);
+        if (sub.empty() || blk.empty())
+          throw InputError(slider_section + ": the block or the substrate has no particle (spacing " +
+                           to_text(a_s) + " m too large for the sizes)");
+        const Tensor<1, dim> blk_size = box(p.block);
+        Tensor<1, dim>       centre;
+        centre[0] = 0.5 * (sub_size[0] - blk_size[0]);
+        if (dim == 3)
+          centre[1] = 0.5 * (sub_size[1] - blk_size[1]);
+        const Tensor<1, dim> shift = placement(sub, blk, centre, a_s, p.periodic ? sub_size[0] : 0.0);
+        for (auto &x : blk)
+          x += shift;
+
+        const auto &m = p.material;
+        n_s = sub.size();
+        n_b = blk.size();
+        sph::add_particles(solver.state, sub, m.rho0, sph::volume_per_particle<dim>(p.lattice, a_s),
+                           p.smoothing_ratio * a_s, 0, 0);
+        const unsigned int first = sph::add_particles(
+          solver.state, blk, m.rho0, sph::volume_per_particle<dim>(p.lattice, a_b), p.smoothing_ratio * a_b, 0, 1);
+        first_block = first;
+
+        // Groups (indices into the state).
+        const double lb = layer_spacing(a_b), tol_b = p.surface == Surface::tilted ? 0.6 * a_b : 0.25 * lb;
+        for (unsigned int i : sph::surface_layer(sub, 0.25 * layer_spacing(a_s), false))
+          fixed.push_back(i);
+        for (unsigned int i : sph::surface_layer(blk, tol_b, true))
+          top.push_back(first + i);
+        for (unsigned int i : sph::surface_layer(blk, tol_b, false))
+          contact.push_back(first + i);
+        double blk_top = -1e300;
+        for (const auto &x : blk)
+          blk_top = std::max(blk_top, x[dim - 1]);
+        for (unsigned int i = 0; i < blk.size(); ++i)
+          {
+            block.push_back(first + i);
+            if (blk[i][dim - 1] > blk_top - (p.driven_layers - 0.5) * lb - tol_b)
+              driven.push_back(first + i);
+          }
+        // Regions: the contact layer in equal groups by initial x (block frame).
+        std::vector<unsigned int> order(contact.size());
+        std::iota(order.begin(), order.end(), 0U);
+        std::sort(order.begin(), order.end(), [&](unsigned int u, unsigned int v) {
+          return solver.state.x[contact[u]][0] < solver.state.x[contact[v]][0];
+        });
+        region.assign(contact.size(), 0);
+        for (unsigned int q = 0; q < order.size(); ++q)
+          region[order[q]] = std::min<unsigned int>(p.regions - 1, q * p.regions / order.size());
+        sum_fx.assign(p.regions, 0);
+        sum_fn.assign(p.regions, 0);
+        v_top.resize(top.size());
+        x_block.resize(block.size());
+        displacement.assign(block.size(), Tensor<1, dim>());
+
+        // Load: P A over the top layer, ramped; bottom fixed.
+        load_area         = dim == 2 ? blk_size[0] : blk_size[0] * blk_size[1];
+        load_per_particle = -p.pressure * load_area / top.size();
+        sph::ExternalForce<dim> load;
+        load.particles = top;
+        load.force     = vertical<dim>(load_per_particle);
+        load.tau       = p.tau;
+        solver.external.push_back(load);
+        sph::ImposedVelocity<dim> bottom;
+        bottom.particles = fixed;
+        solver.imposed.push_back(bottom);
+        set_damping(solver, p.settling_gamma, false);
+
+        const auto [E, nu] = young_and_poisson(m);
+        std::ostringstream os;
+        os << "sph_slider " << dim << "D " << m.name << ": substrate " << n_s << " particles (a = " << a_s
+           << " m" << (p.periodic ? ", periodic in x with period " + to_text(sub_size[0]) + " m" : "")
+           << "), block " << n_b << " (a = " << a_b << " m), h = " << p.smoothing_ratio << " a; E = " << E
+           << " Pa, nu = " << nu << "; boundary " << solver.parameters().boundary.describe() << "; load "
+           << top.size() << " particles, P A = " << p.pressure * load_area << (dim == 2 ? " N/m" : " N")
+           << "; contact layer " << contact.size() << ", driven " << driven.size() << ", fixed " << fixed.size();
+        log(os.str());
+      }
+
+      /// Damping of both bodies at rate @p gamma (1/s): relative to a fixed reference
+      /// (block: (V, 0, 0) once sliding, 0 before; substrate: 0), or to each body's
+      /// centre-of-mass velocity (Damping reference = centre of mass, while sliding).
+      void set_damping(sph::Solver<dim> &solver, double gamma, bool slide) const
+      {
+        solver.damping.clear();
+        if (gamma <= 0)
+          return;
+        const bool     com = slide && !p.damping_to_sliding_velocity;
+        sph::Damping   sub{0, gamma, com, {{0, 0, 0}}};
+        sph::Damping   blk{1, gamma, com, {{slide ? p.velocity : 0.0, 0, 0}}};
+        solver.damping = {sub, blk};
+      }
+
+      /// Slide start: every block particle gets v_x = V (the paper's first step), the
+      /// damping switches to the sliding phase's gamma.
+      void start_sliding(sph::Solver<dim> &solver)
+      {
+        sliding = true;
+        for (unsigned int i : block)
+          solver.state.v[i][0] = p.velocity;
+        set_damping(solver, p.gamma, true);
+      }
+
+      SliderParameters            p;
+      unsigned int                n_b = 0, n_s = 0, first_block = 0;
+      std::vector<unsigned int>   fixed, top, contact, driven, block, region;
+      std::vector<double>         sum_fx, sum_fn;
+      std::vector<Tensor<1, dim>> v_top, x_block, displacement;
+      double load_area = 0, load_per_particle = 0, work_pressure = 0, work_drive = 0;
+      double drive_impulse = 0, interval = 0;
+      bool   sliding = false;
+    };
+
+    /// The solver of the slider: spring boundary law f1 with K = k E a^(dim-2) (N/m in 3D,
+    /// Pa = N/m per m in 2D; the paper's eq. 25 estimate K ~ E h) and range d = ratio a.
+    template <int dim>
+    sph::SolverParameters slider_solver(const SliderParameters &p, double substrate_period)
+    {
+      sph::SolverParameters s;
+      s.alpha    = p.alpha;
+      s.beta     = p.beta;
+      s.courant  = p.courant;
+      s.dt_min   = p.dt_min;
+      s.period   = p.periodic ? substrate_period : 0;
+      const double E = young_and_poisson(p.material).first;
+      s.boundary = sph::BoundaryForce::spring(p.stiffness_factor * E * std::pow(p.spacing, dim - 2),
+                                              p.range_ratio * p.spacing);
+      return s;
+    }
+
+    /// Builds the slider of @p p (after checking the periodic length against the
+    /// neighbour search's 3 cut-offs) and runs it; returns the exit code.
+    template <int dim>
+    int run_slider(EntryReader &r, const SliderParameters &p, const std::string &dir, Log &log,
+                   const RunOptions &o)
+    {
+      const double period = std::max(3.0, std::round(p.substrate[0] / p.spacing)) * p.spacing;
+      if (p.periodic && period < 3 * 2 * std::max(p.smoothing_ratio, p.range_ratio) * p.spacing *
+                                   (p.surface == Surface::incommensurate ? p.ratio : 1.0))
+        r.fail(slider_section + "/Substrate size", "a substrate at least 3 cut-offs long when periodic");
+      sph::Solver<dim> solver({p.material}, slider_solver<dim>(p, period));
+      Slider<dim>      slider(p, solver, log);
+      JsonObject       summary;
+      summary.set("case", o.case_file);
+      summary.set("n_block", long(slider.n_block()));
+      summary.set("n_substrate", long(slider.n_substrate()));
+      return run_loop(solver, slider, {"sph_slider", p.end_time, p.statistics_interval, p.field_interval},
+                      r.read, summary, dir, log, o);
+    }
+
+    // ------------------------------------------------------------------------------------
+    // The cantilever plate
+
+    /// First mode of a clamped-free beam, w(x) = cosh kx - cos kx - s (sinh kx - sin kx),
+    /// s = (cosh kL + cos kL)/(sinh kL + sin kL), kL = 1.875104 (dimensionless shape).
+    double cantilever_mode(double x, double L)
+    {
+      const double kL = 1.875104068711961, k = kL / L;
+      const double s  = (std::cosh(kL) + std::cos(kL)) / (std::sinh(kL) + std::sin(kL));
+      return std::cosh(k * x) - std::cos(k * x) - s * (std::sinh(k * x) - std::sin(k * x));
+    }
+
+    /// The cantilever plate (2D plane strain): a plate 0 <= x < L, 0 <= y < H clamped by
+    /// three fixed columns at x < 0, started with the first mode's velocity
+    /// v_y(x) = V w(x)/w(L) (V the tip velocity). Thin-plate theory:
+    /// omega^2 = E H^2 k^4/(12 rho (1 - nu^2)), kL = 1.875 (E, nu of the small-strain
+    /// moduli). The tip deflection w_tip(t) = (V/omega) sin(omega t): its first zero after
+    /// t = 0 is at pi/omega; before that the first zero of the tip velocity, pi/(2 omega).
+    class Plate : public Experiment<2>
+    {
+    public:
+      Plate(const PlateParameters &p, sph::Solver<2> &solver, Log &log) : p(p)
+      {
+        const double a = p.spacing;
+        Tensor<1, 2> origin, size;
+        origin[0] = -3 * a;
+        size[0]   = p.length + 3 * a;
+        size[1]   = p.thickness;
+        const auto pts = sph::lattice_points<2>(sph::LatticeType::cubic, origin, size, a);
+        sph::add_particles(solver.state, pts, p.material.rho0, a * a, p.smoothing_ratio * a, 0, 0);
+        sph::ImposedVelocity<2> clamp;
+        double                  x_max = -1e300;
+        for (const auto &x : pts)
+          x_max = std::max(x_max, x[0]);
+        for (unsigned int i = 0; i < pts.size(); ++i)
+          {
+            if (pts[i][0] < 0)
+              clamp.particles.push_back(i);
+            else
+              solver.state.v[i][1] = p.tip_velocity * cantilever_mode(pts[i][0], p.length) /
+                                     cantilever_mode(p.length, p.length);
+            if (pts[i][0] > x_max - 0.25 * a)
+              {
+                tip.push_back(i);
+                y0.push_back(pts[i][1]);
+              }
+          }
+        solver.imposed.push_back(clamp);
+        const auto [E, nu] = young_and_poisson(p.material);
+        const double k     = 1.875104068711961 / p.length;
+        omega = std::sqrt(E * p.thickness * p.thickness * k * k * k * k /
+                          (12 * p.material.rho0 * (1 - nu * nu)));
+        std::ostringstream os;
+        os << "sph_plate 2D " << p.material.name << ": " << pts.size() << " particles (" << clamp.particles.size()
+           << " clamped), L = " << p.length << " m, H = " << p.thickness << " m, E = " << E << " Pa, nu = " << nu
+           << "; thin-plate omega = " << omega << " 1/s (period " << 2 * M_PI / omega << " s)";
+        log(os.str());
+      }
+
+      std::vector<std::string> columns() const override
+      {
+        return {"tip_deflection", "tip_velocity", "kinetic_energy", "internal_energy", "total_energy"};
+      }
+      void before_step(sph::Solver<2> &) override {}
+
+      /// Records the tip deflection (mean over the tip column, m) and velocity (m/s)
+      /// at every step and finds the first zero crossings.
+      void after_step(sph::Solver<2> &solver, double) override
+      {
+        double w = 0, v = 0;
+        tip_state(solver, w, v);
+        const double t = solver.time;
+        if (t_v0 == 0 && v_prev > 0 && v <= 0)
+          t_v0 = t_prev + (t - t_prev) * v_prev / (v_prev - v);
+        if (t_w0 == 0 && w_prev > 0 && w <= 0)
+          t_w0 = t_prev + (t - t_prev) * w_prev / (w_prev - w);
+        t_prev = t;
+        w_prev = w;
+        v_prev = v;
+      }
+
+      std::vector<double> row(const sph::Solver<2> &solver) override
+      {
+        double w = 0, v = 0;
+        tip_state(solver, w, v);
+        const double ke = solver.state.kinetic_energy(), ei = solver.state.internal_energy();
+        return {w, v, ke, ei, ke + ei};
+      }
+
+      void summarize(const TimeSeries &stats, double, JsonObject &res) const override
+      {
+        const double measured = t_w0 > 0 ? M_PI / t_w0 : t_v0 > 0 ? M_PI / (2 * t_v0) : 0.0;
+        res.set("omega_analytic", omega);
+        res.set("omega_measured", measured);
+        res.set("omega_ratio", measured / omega);
+        res.set("measured_from", t_w0 > 0 ? "tip deflection zero (t = pi/omega)"
+                                 : t_v0 > 0 ? "tip velocity zero (t = pi/(2 omega))" : "none (run too short)");
+        res.set("first_velocity_zero", t_v0);
+        res.set("first_deflection_zero", t_w0);
+        const auto w = stats.column("tip_deflection");
+        res.set("max_tip_deflection", *std::max_element(w.begin(), w.end()));
+        res.set("amplitude_thin_plate", p.tip_velocity / omega);
+        const auto e = stats.column("total_energy");
+        res.set("energy_change_ratio", e.front() > 0 ? (e.back() - e.front()) / e.front() : 0.0);
+      }
+
+    private:
+      /// Mean vertical displacement @p w (m) and velocity @p v (m/s) of the tip column.
+      void tip_state(const sph::Solver<2> &solver, double &w, double &v) const
+      {
+        w = v = 0;
+        for (unsigned int q = 0; q < tip.size(); ++q)
+          {
+            w += solver.state.x[tip[q]][1] - y0[q];
+            v += solver.state.v[tip[q]][1];
+          }
+        w /= tip.size();
+        v /= tip.size();
+      }
+
+      PlateParameters           p;
+      std::vector<unsigned int> tip;
+      std::vector<double>       y0;
+      double                    omega = 0;
+      double t_prev = 0, w_prev = 0, v_prev = 0, t_v0 = 0, t_w0 = 0;
+    };
+
+    /// Reads "SPH plate", builds the plate and runs it; returns the exit code.
+    int run_plate(EntryReader &r, const std::string &dir, Log &log, const RunOptions &o)
+    {
+      const PlateParameters p = read_plate(r);
+      sph::SolverParameters s;
+      s.alpha   = p.alpha;
+      s.beta    = p.beta;
+      s.courant = p.courant;
+      s.dt_min  = p.dt_min;
+      sph::Solver<2> solver({p.material}, s);
+      Plate          plate(p, solver, log);
+      JsonObject     summary;
+      summary.set("case", o.case_file);
+      return run_loop<2>(solver, plate, {"sph_plate", p.end_time, p.statistics_interval, p.field_interval},
+                         r.read, summary, dir, log, o);
+    }
+  } // namespace
+
+  void declare_sph_scene_parameters(dealii::ParameterHandler &prm)
+  {
+    prm.enter_subsection(slider_section);
+    prm.declare_entry("Material", "granite", Selection("granite|basalt"),
+                      "Rock of both bodies: Tillotson equation of state and shear modulus "
+                      "(docs/sph.md; granite G = 9.72 GPa, basalt G = 22.7 GPa).");
+    prm.declare_entry("Dimension", "3", Selection("2|3"),
+                      "2 (plane strain, forces per metre of depth) or 3. The vertical axis is the last.");
+    prm.declare_entry("Lattice", "cubic", Selection("cubic|hcp"),
+                      "Lattice of both bodies: square/simple cubic or hexagonal (2D)/hexagonal close-packed (3D).");
+    prm.declare_entry("Particle spacing", "3.125e-4", Double(),
+                      "Nearest-neighbour spacing a of the substrate (and of the block unless incommensurate), m, > 0.");
+    prm.declare_entry("Smoothing length ratio", "1.2", Double(), "h/a, in [1, 2].");
+    prm.declare_entry("Block size", "5e-3, 3.75e-3, 2.5e-3", Anything(),
+                      "Block box \"Lx, Ly, Lz\", m, z vertical; 2D uses Lx and Lz. Paper: 0.5 x 0.375 x 0.25 cm.");
+    prm.declare_entry("Substrate size", "1e-2, 5e-3, 2.5e-3", Anything(),
+                      "Substrate box \"Lx, Ly, Lz\", m (Lx rounded to a whole number of spacings when periodic). "
+                      "Paper: 1 x 0.5 x 0.25 cm.");
+    prm.declare_entry("Periodic", "true", Bool(),
+                      "Substrate (and the whole domain) periodic along x with period Lx: the block never reaches an edge.");
+    prm.declare_entry("Pressure", "1e8", Double(),
+                      "Normal pressure P on the block's top layer, Pa (> 0), as equal vertical forces P A/n.");
+    prm.declare_entry("Pressure ramp time", "3e-5", Double(), "tau of the ramp P (1 - exp(-t/tau)), s (> 0).");
+    prm.declare_entry("Sliding velocity", "1", Double(),
+                      "Horizontal velocity V imposed on the block's driven top layer(s) from the slide start, m/s (>= 0).");
+    prm.declare_entry("Slide start", "1.5e-4", Double(),
+                      "Time at which sliding starts (all block particles get v_x = V once), s; below the end time.");
+    prm.declare_entry("Gamma", "1e6", Double(),
+                      "Damping rate gamma of both bodies while sliding, 1/s (>= 0; 0: none). Paper: 1e6 - 1e9.");
+    prm.declare_entry("Settling gamma", "1e6", Double(),
+                      "Damping rate before the slide start (settling under the ramped load), 1/s (>= 0).");
+    prm.declare_entry("Damping reference", "centre of mass", Selection("centre of mass|sliding velocity"),
+                      "While sliding: 'centre of mass' damps each body toward its own centre-of-mass velocity "
+                      "(eq. 36, f = -m gamma (v - v_cm): no net force, so the drive alone balances the friction); "
+                      "'sliding velocity' damps the block toward (V, 0, 0) and the substrate toward 0 (the paper's "
+                      "f = -m gamma (v_x - V), -m gamma v_y, -m gamma v_z: the damping then also pushes the block "
+                      "and holds it vertically). Before sliding both bodies are damped toward rest.");
+    prm.declare_entry("Driven layers", "2", Integer(1),
+                      "Number of top layers of the block whose horizontal velocity is imposed (vertical free), >= 1. "
+                      "The paper drives the first and sometimes the second layer; with one driven layer the "
+                      "SPH block lags ever more behind it at 1e8 Pa (the driven layer shears through the "
+                      "block), with two it follows (docs/validation.md).");
+    prm.declare_entry("Artificial viscosity alpha", "1", Double(), "Monaghan viscosity alpha, >= 0.");
+    prm.declare_entry("Artificial viscosity beta", "0.1", Double(), "Monaghan viscosity beta, >= 0.");
+    prm.declare_entry("CFL number", "0.3", Double(), "C in dt = C h/(c (1 + 1.2 alpha) + beta max mu), in (0, 1].");
+    prm.declare_entry("Step floor", "1e-12", Double(),
+                      "Smallest allowed step, s (> 0): a smaller one ends the run with status failed.");
+    prm.declare_entry("Boundary stiffness factor", "1",  Double(),
+                      "k in the spring law f1 between the bodies, K = k E a^(dim-2) (N/m in 3D, N/m per m "
+                      "of depth in 2D; the paper's K ~ E h estimate), > 0.");
+    prm.declare_entry("Boundary range ratio", "1", Double(),
+                      "Range d of f1 as a fraction of a, in (0, 2); the block starts a distance d above the substrate.");
+    prm.declare_entry("Surface", "periodic",
+                      Selection("periodic|tilted|incommensurate|step|holes|random heights|fractal"),
+                      "Contact surfaces: 'periodic' (aligned lattices), 'tilted' (block lattice rotated by Tilt angle), "
+                      "'incommensurate' (block spacing = Mesh ratio x a), 'step' (one-particle step on the substrate "
+                      "beyond Step position), 'holes' (Hole fraction of the substrate's top layer removed), "
+                      "'random heights' (substrate top moved uniformly in +/- dz/2), 'fractal' (self-affine "
+                      "substrate top of dimension D_f, rms height dz).");
+    prm.declare_entry("Tilt angle", "10", Double(), "Tilt of the block's lattice in the x-vertical plane, degrees, [0, 45].");
+    prm.declare_entry("Mesh ratio", "1.618033988749895", Double(),
+                      "Block spacing / substrate spacing for 'incommensurate' (> 0, != 1; golden mean by default).");
+    prm.declare_entry("Hole fraction", "0.3", Double(), "Fraction of the substrate's top particles removed, [0, 1).");
+    prm.declare_entry("Roughness amplitude", "1.5e-4", Double(),
+                      "dz, m (>= 0): full width of the uniform heights, or rms of the fractal heights.");
+    prm.declare_entry("Fractal dimension", "2.5", Double(), "D_f of the fractal substrate, in (dim - 1, dim).");
+    prm.declare_entry("Step position", "6e-3", Double(), "x beyond which the substrate is one layer higher, m (>= 0).");
+    prm.declare_entry("Seed", "1", Integer(0), "Seed of the random surfaces, >= 0.");
+    prm.declare_entry("Local friction regions", "4", Integer(1),
+                      "Number of equal groups (by initial x) of the contact layer with their own mu, >= 1.");
+    prm.declare_entry("Statistics interval", "1e-6", Double(),
+                      "Simulated time between rows of statistics.csv, s (> 0); forces are averaged over it.");
+    prm.declare_entry("Field interval", "5e-5", Double(),
+                      "Simulated time between VTU snapshots, s (>= 0; 0: first and last only).");
+    prm.declare_entry("Averaging fraction", "0.5", Double(),
+                      "mu_mean and mu_std in summary.json average the last N whole lattice periods a/V within the last "
+                      "fraction f of the sliding phase (the last f of it if shorter than one period), in (0, 1].");
+    prm.leave_subsection();
+
+    prm.enter_subsection(plate_section);
+    prm.declare_entry("Material", "granite", Selection("granite|basalt"), "Rock of the plate.");
+    prm.declare_entry("Length", "0.2", Double(), "Free length L of the plate, m (> 0).");
+    prm.declare_entry("Thickness", "0.02", Double(), "Thickness H, m (>= 3 spacings, <= L/3).");
+    prm.declare_entry("Particle spacing", "3.333333333333333e-3", Double(), "Square-lattice spacing a, m (> 0).");
+    prm.declare_entry("Smoothing length ratio", "1.2", Double(), "h/a, in [1, 2].");
+    prm.declare_entry("Tip velocity", "0.05", Double(), "Initial tip velocity V of the first mode, m/s (> 0).");
+    prm.declare_entry("Artificial viscosity alpha", "1", Double(), "Monaghan viscosity alpha, >= 0.");
+    prm.declare_entry("Artificial viscosity beta", "0.1", Double(), "Monaghan viscosity beta, >= 0.");
+    prm.declare_entry("CFL number", "0.3", Double(), "CFL number, in (0, 1].");
+    prm.declare_entry("Step floor", "1e-12", Double(), "Smallest allowed step, s (> 0).");
+    prm.declare_entry("Statistics interval", "2e-5", Double(), "Simulated time between rows, s (> 0).");
+    prm.declare_entry("Field interval", "0", Double(), "Simulated time between VTU snapshots, s (>= 0).");
+    prm.leave_subsection();
+  }
+
+  void check_sph_scene(const ParameterFile &file)
+  {
+    EntryReader r(file);
+    if (r.text("Simulation/Scene") == "sph_plate")
+      read_plate(r);
+    else
+      read_slider(r);
+  }
+
+  int run_sph_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o)
+  {
+    EntryReader r(file);
+    try
+      {
+        const std::string scene = r.text("Simulation/Scene");
+        if (scene == "sph_plate")
+          return run_plate(r, dir, log, o);
+        const SliderParameters p = read_slider(r);
+        return p.dim == 2 ? run_slider<2>(r, p, dir, log, o) : run_slider<3>(r, p, dir, log, o);
+      }
+    catch (const InputError &e)
+      {
+        // The directory already holds a "running" summary: mark it.
+        JsonObject summary;
+        summary.set("status", "failed");
+        summary.set("case", o.case_file);
+        summary.set("error", std::string(e.what()));
+        atomic_write((fs::path(dir) / "summary.json").string(), summary.to_string());
+        log(std::string("input error: ") + e.what());
+        throw;
+      }
+  }
+} // namespace tribo::app
