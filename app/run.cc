@@ -449,6 +449,11 @@ namespace tribo::app
        << (step ? double(total_iterations) / step : 0.0) << " NLGS sweeps per step, "
        << non_converged << " steps not converged, worst overlap " << worst_overlap << " m";
     log(os.str());
+    return finish_run(log, status, failure);
+  }
+
+  int finish_run(Log &log, const std::string &status, const std::string &failure)
+  {
     if (status == "failed")
       {
         log("error: " + failure);

@@ -5,6 +5,11 @@
 #include <string>
 #include <vector>
 
+namespace tribo
+{
+  class Log; // core/output.h
+}
+
 namespace tribo::app
 {
   struct RunOptions
@@ -22,6 +27,10 @@ namespace tribo::app
   /// Run (or only check) a case; returns the process exit code. Input errors
   /// are thrown as InputError before anything is written.
   int run_case(const RunOptions &options);
+
+  /// The end of every scene's run: log the error or the signal and return the exit code
+  /// (0 complete, 1 failed with @p failure, 128 + signal interrupted).
+  int finish_run(Log &log, const std::string &status, const std::string &failure);
 
   /// The "status" of DIR/summary.json (running, complete, interrupted, failed), or "" if
   /// there is none or it cannot be read.

@@ -1144,17 +1144,6 @@ namespace tribo::app
     std::ostringstream os;
     os << "status " << status << ": " << step << " steps in " << wall << " s";
     log(os.str());
-    if (status == "failed")
-      {
-        log("error: " + failure);
-        return exit_run_error;
-      }
-    if (status == "interrupted")
-      {
-        log("interrupted by signal " + std::to_string(stop_requested()) +
-            ": outputs hold the steps done so far");
-        return 128 + stop_requested();
-      }
-    return exit_ok;
+    return finish_run(log, status, failure);
   }
 } // namespace tribo::app

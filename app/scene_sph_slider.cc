@@ -464,18 +464,7 @@ namespace tribo::app
       os << "status " << status << ": " << step << " steps to t = " << solver.time << " s in " << wall
          << " s; step " << (step ? dt_lo : 0.0) << " .. " << dt_hi << " s";
       log(os.str());
-      if (status == "failed")
-        {
-          log("error: " + failure);
-          return exit_run_error;
-        }
-      if (status == "interrupted")
-        {
-          log("interrupted by signal " + std::to_string(stop_requested()) +
-              ": outputs hold the steps done so far");
-          return 128 + stop_requested();
-        }
-      return exit_ok;
+      return finish_run(log, status, failure);
     }
 
     /// Mean of @p v over indices in @p rows.
