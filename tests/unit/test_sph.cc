@@ -8,6 +8,8 @@
 #include "sph/particles.h"
 #include "sph/solver.h"
 
+#include "tests/unit/sph_test_util.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,20 +18,10 @@
 
 using namespace tribo::sph;
 using tribo::RunError;
+using tribo::sph::testing::vec;
 
 namespace
 {
-  template <int dim>
-  Tensor<1, dim> vec(double x, double y, double z = 0)
-  {
-    Tensor<1, dim> t;
-    t[0] = x;
-    t[1] = y;
-    if constexpr (dim == 3)
-      t[2] = z;
-    return t;
-  }
-
   /// Particles at least @p margin inside the bounding box of @p s.
   template <int dim>
   std::vector<unsigned int> interior(const ParticleState<dim> &s, double margin)

@@ -7,6 +7,8 @@
 
 #include <deal.II/base/multithread_info.h>
 
+#include "tests/unit/sph_test_util.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,20 +16,10 @@
 
 using namespace tribo::sph;
 using tribo::RunError;
+using tribo::sph::testing::vec;
 
 namespace
 {
-  template <int dim>
-  Tensor<1, dim> vec(double x, double y, double z = 0)
-  {
-    Tensor<1, dim> t;
-    t[0] = x;
-    t[1] = y;
-    if constexpr (dim == 3)
-      t[2] = z;
-    return t;
-  }
-
   /// A block of granite-like linear solid on a lattice of spacing a, h = 1.2 a.
   template <int dim>
   Solver<dim> make_block(const Tensor<1, dim> &size, double a, LatticeType type,
