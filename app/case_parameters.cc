@@ -2,6 +2,7 @@
 
 #include "app/particle_scenes.h"
 #include "core/errors.h"
+#include "coupling/first_body.h"
 
 #include <cmath>
 
@@ -126,7 +127,7 @@ namespace tribo::app
     prm.declare_entry("Compaction speed limit", "1", Double(),
                       "Before Shear start, the upper wall's vertical speed is capped at this value, m/s "
                       "(>= 0; 0: no cap), so that the compaction stroke under P cannot hit the grains "
-                      "at tens of m/s and tunnel into the layer. Not applied while shearing, nor to a fem "
+                      "at tens of m/s and tunnel into the layer. Not applied while shearing, nor to a deformable "
                       "upper body (see Upper body compaction damping).");
     prm.declare_entry("Upper body thickness", "1.5e-4", Double(),
                       "Thickness of the first body the upper wall stands for, m (> 0; paper: 1.5e-4): "
@@ -136,17 +137,23 @@ namespace tribo::app
     prm.declare_entry("Layer thickness", "0", Double(),
                       "Thickness of the profile layers, m (>= 0); 0: one mean diameter.");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
-    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem"),
+    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|sph|mlp"),
                       "rigid: a rough wall of discs with the mass of the first body (the paper's "
                       "classical model); fem: a plane-strain elastic body of that thickness "
-                      "(deal.II), touched through half-disc elements (the paper's hybrid model).");
+                      "(deal.II), touched through half-disc elements (the paper's hybrid model); "
+                      "sph, mlp: the same body as an SPH (square lattice) or movable-lattice-particle "
+                      "(hexagonal lattice) block whose bottom row of particles carries the half-discs, "
+                      "sub-cycled inside each contact step (docs/first_bodies.md).");
     prm.declare_entry("Upper body Young's modulus", "1e11", Double(),
-                      "E of the fem upper body, Pa (> 0; paper: 1e11 and 3e9).");
+                      "E of the deformable upper body, Pa (> 0; paper: 1e11 and 3e9).");
     prm.declare_entry("Upper body Poisson ratio", "0.33", Double(),
-                      "nu of the fem upper body (in (-1, 0.5); paper: 0.33).");
+                      "nu of the deformable upper body, plane strain (in (-1, 0.5); paper: 0.33; "
+                      "mlp: at most 0.25).");
     prm.declare_entry("Upper body cell size", "0", Double(),
-                      "Cell size of the fem upper body's mesh, m (>= 0); 0: the smallest grain "
-                      "diameter d(1-s), the paper's choice.");
+                      "Cell size of the fem upper body's mesh, or particle spacing of the sph and mlp "
+                      "bodies, m (>= 0); 0: the smallest grain diameter d(1-s), the paper's choice.");
+    prm.declare_entry("Upper body smoothing length ratio", "1.2", Double(),
+                      "Smoothing length over particle spacing of the sph upper body (in [1, 2]).");
     prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
                       "Degree p of the fem upper body's Q_p elements.");
     prm.declare_entry("Upper body mass damping", "0", Double(),
@@ -157,7 +164,7 @@ namespace tribo::app
                       "Diameter of the half-disc contact elements on the fem upper body, m (>= 0); "
                       "0: the cell size (one per boundary edge, the paper's choice).");
     prm.declare_entry("Upper body compaction damping", "1", Double(),
-                      "Damping ratio zeta (>= 0) of the fem upper body's first thickness mode, "
+                      "Damping ratio zeta (>= 0) of the deformable upper body's first thickness mode, "
                       "omega_1 = pi c_p / (2 H), added before Shear start as stiffness-proportional "
                       "damping b_c = 2 zeta / omega_1 and removed when shearing starts: the body lands "
                       "on the layer at about 1 m/s and would otherwise ring (no numerical damping at "
@@ -247,7 +254,9 @@ namespace tribo::app
         sc.profile_samples = f.get_integer(S + "Profile samples");
         sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");
         sc.seed = f.get_integer(S + "Seed");
-        sc.deformable_upper_body = f.get(S + "Upper body model") == "fem";
+        sc.upper_body_model = f.get(S + "Upper body model");
+        sc.sph_smoothing_ratio = f.get_checked(S + "Upper body smoothing length ratio",
+                                               [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
         sc.upper_youngs_modulus = f.get_checked(S + "Upper body Young's modulus", positive, "a positive modulus in Pa");
         sc.upper_poisson_ratio = f.get_checked(S + "Upper body Poisson ratio", [](double v) { return v > -1 && v < 0.5; },
                                                "a Poisson ratio in (-1, 0.5)");
@@ -257,7 +266,39 @@ namespace tribo::app
         sc.upper_stiffness_damping = f.get_checked(S + "Upper body stiffness damping", non_negative, "a coefficient >= 0 in s");
         sc.half_disc_diameter = f.get_checked(S + "Half-disc diameter", non_negative, "a diameter >= 0 in m");
         sc.upper_compaction_damping = f.get_checked(S + "Upper body compaction damping", non_negative, "a damping ratio >= 0");
+        if (sc.upper_body_model != "rigid")
+          try
+            {
+              coupling::check_first_body(first_body_parameters(p));
+            }
+          catch (const InputError &e)
+            {
+              throw InputError(f.filename() + ": " + e.what());
+            }
       }
     return p;
+  }
+
+  coupling::FirstBodyParameters first_body_parameters(const CaseParameters &p)
+  {
+    const auto                   &k = p.shear;
+    coupling::FirstBodyParameters b;
+    b.model              = k.upper_body_model;
+    b.length             = k.length;
+    b.thickness          = k.upper_body_thickness;
+    b.youngs_modulus     = k.upper_youngs_modulus;
+    b.poisson_ratio      = k.upper_poisson_ratio;
+    b.density            = k.density;
+    b.resolution         = k.upper_cell_size > 0 ? k.upper_cell_size : k.mean_diameter * (1 - k.diameter_spread);
+    b.degree             = k.upper_degree;
+    b.rayleigh_mass      = k.upper_mass_damping;
+    b.rayleigh_stiffness = k.upper_stiffness_damping;
+    b.theta              = p.theta;
+    b.time_step          = p.time_step;
+    b.pressure           = k.pressure;
+    b.pressure_ramp_time = k.ramp_time;
+    b.compaction_damping = k.shear_start > 0 ? k.upper_compaction_damping : 0.0;
+    b.smoothing_ratio    = k.sph_smoothing_ratio;
+    return b;
   }
 } // namespace tribo::app

@@ -3,6 +3,7 @@
 /// units) and validated reading into plain structs.
 
 #include "core/parameter_file.h"
+#include "coupling/first_body.h"
 #include "dem/contact_law.h"
 #include "dem/nlgs.h"
 
@@ -42,12 +43,16 @@ namespace tribo::app
     unsigned int profile_samples;      ///< profile samples over the shearing phase
     double       layer_thickness;      ///< profile layer thickness, m (0: d)
     unsigned int seed;
-    /// The upper first body: a rigid rough wall (clump) or the deal.II body (fem/)
-    /// touched through half-disc elements (dem/boundary.h).
-    bool         deformable_upper_body = false;
-    double       upper_youngs_modulus;  ///< E, Pa (fem)
-    double       upper_poisson_ratio;   ///< nu (fem)
-    double       upper_cell_size;       ///< m (fem); 0: the smallest grain diameter d(1-s)
+    /// The upper first body: rigid (a rough wall, a clump of discs), or deformable and
+    /// touched through half-disc elements (dem/boundary.h): fem (the deal.II body of
+    /// fem/), sph or mlp (particle blocks, coupling/particle_first_body.h).
+    std::string  upper_body_model = "rigid";
+    double       upper_youngs_modulus;  ///< E, Pa (fem, sph, mlp)
+    double       upper_poisson_ratio;   ///< nu (fem, sph, mlp)
+    /// Cell size (fem) or particle spacing (sph, mlp), m; 0: the smallest grain
+    /// diameter d(1-s)
+    double       upper_cell_size;
+    double       sph_smoothing_ratio;   ///< h / spacing (sph)
     unsigned int upper_degree;          ///< Q_p element degree (fem)
     double       upper_mass_damping;    ///< Rayleigh a, 1/s (fem)
     double       upper_stiffness_damping; ///< Rayleigh b, s (fem)
@@ -81,4 +86,7 @@ namespace tribo::app
 
   /// Read and check a parsed case; InputError names the entry and what was expected.
   CaseParameters read_case_parameters(const ParameterFile &file);
+  /// The shear cell's deformable upper body as the coupling module takes it (bottom
+  /// face y0 = 0: the scene places it).
+  coupling::FirstBodyParameters first_body_parameters(const CaseParameters &p);
 } // namespace tribo::app

@@ -269,6 +269,8 @@ namespace tribo::app
       os << "scene " << p.scene << ": " << system.bodies.size() << " bodies, " << system.discs.size()
          << " discs; h = " << h << " s, " << n_steps << " steps, detection distance " << mj.detection_distance() << " m";
       log(os.str());
+      if (!scene->description().empty())
+        log(scene->description());
     }
 
     std::vector<std::string> columns = common_columns;

@@ -29,6 +29,8 @@ namespace tribo::app
     {
       return {};
     }
+    /// Extra lines for the log after build() (e.g. a deformable body's size); "" for none.
+    virtual std::string description() const { return ""; }
     /// The time step to use (the case's, unless the scene derives it).
     virtual double time_step(const dem::ParticleSystem &) const { return prm.time_step; }
     /// Adjust loads before step @p step (e.g. a pressure ramp).

@@ -7,20 +7,20 @@
 // wall's speed capped (Compaction speed limit); a Shear start at or after the End
 // time gives a compaction-only run.
 //
-// With `Upper body model = fem` the upper first body is the deal.II plane-strain body
-// of fem/ (Fig. 3b of the paper): same thickness, density and period, the pressure P as
-// a traction on its top face (ramped the same way), held in x on its top face, touched
-// by the grains through half-disc elements on its bottom face. Its bottom face stands
-// where the rigid wall's disc centres would be, less half a wall disc plus half a
-// half-disc, so that both models start from the same layer.
+// With `Upper body model = fem | sph | mlp` the upper first body is deformable
+// (coupling/first_body.h): the deal.II plane-strain body of fem/ (Fig. 3b of the
+// paper), or an SPH or MLP particle block; same thickness, density and period, the
+// pressure P on its top face (ramped the same way), held in x on its top face, touched
+// by the grains through half-disc elements on its bottom face (the bottom row of
+// particles for sph and mlp). Its bottom face stands where the rigid wall's disc
+// centres would be, less half a wall disc plus half a half-disc, so that all models
+// start from the same layer.
 #include "app/profiles.h"
 #include "app/scene.h"
 #include "app/steady_state.h"
 #include "core/errors.h"
 
-#ifdef TRIBO_WITH_FEM
-#include "coupling/elastic_boundary.h"
-#endif
+#include "coupling/first_body.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -68,7 +68,7 @@ namespace tribo::app
           }
 
         const double upper_y = d_max + 0.5 * pitch + (rows - 1) * dy + pitch;
-        if (k.deformable_upper_body)
+        if (k.upper_body_model != "rigid")
           build_deformable_upper_body(upper_y - 0.5 * lower_wall_diameter);
         else
           {
@@ -96,14 +96,12 @@ namespace tribo::app
         normal_force                 = ramp * k.pressure * k.length;
         sliding                      = t >= k.shear_start;
         s.bodies[lower].velocity.x() = sliding ? k.sliding_velocity : 0.0;
-        if (upper == LayerProfiles::no_body)
+        if (body)
           {
-#ifdef TRIBO_WITH_FEM
-            // The body ramps its own traction, with the same law; the compaction
-            // damping goes when shearing starts.
+            // The body ramps its own load, with the same law; the compaction damping
+            // goes when shearing starts.
             if (sliding)
-              elastic->set_damping(k.upper_mass_damping, k.upper_stiffness_damping);
-#endif
+              body->start_shearing();
             return;
           }
         s.bodies[upper].load[1] = -normal_force;
@@ -113,28 +111,18 @@ namespace tribo::app
           vy = std::clamp(vy, -k.compaction_speed, k.compaction_speed);
       }
 
+      std::string description() const override { return body ? body->describe() : ""; }
+
       void attach(dem::MoreauJean &mj) override
       {
-#ifdef TRIBO_WITH_FEM
-        if (boundary)
-          mj.attach(*boundary, half_disc_diameter, {0, -1}, prm.shear.length);
-#else
-        (void)mj;
-#endif
+        if (body)
+          mj.attach(*body, half_disc_diameter, {0, -1}, prm.shear.length);
       }
 
       std::vector<std::string> write_fields(const std::string &dir, unsigned int index) const override
       {
-#ifdef TRIBO_WITH_FEM
-        if (elastic)
-          {
-            const std::string name = "upper_body_" + std::to_string(100000 + index).substr(1) + ".vtu";
-            elastic->write_vtu(dir + "/" + name);
-            return {name};
-          }
-#endif
-        (void)dir;
-        (void)index;
+        if (body)
+          return {body->write_fields(dir, index)};
         return {};
       }
 
@@ -264,10 +252,8 @@ namespace tribo::app
         random << rng;
         ar << random.str() << steps_done << sliding << normal_force;
         profiles->save(ar);
-#ifdef TRIBO_WITH_FEM
-        if (elastic)
-          elastic->save(ar);
-#endif
+        if (body)
+          body->save(ar);
       }
 
       void load(CheckpointIn &ar) override
@@ -277,21 +263,19 @@ namespace tribo::app
         std::istringstream is(random);
         is >> rng;
         profiles->load(ar);
-#ifdef TRIBO_WITH_FEM
-        if (elastic)
-          elastic->load(ar);
-#endif
+        if (body)
+          body->load(ar);
       }
 
     private:
       /// What the statistics need from the upper first body, whatever its model.
       struct Upper
       {
-        double y, vy;          ///< wall centre line (rigid) or mean bottom face (fem), m and m/s
+        double y, vy;          ///< wall centre line (rigid) or mean bottom face (deformable), m and m/s
         double surface;        ///< the surface the grains touch, m
         double power;          ///< power of its external load over the step, W/m
         double kinetic_energy; ///< J/m
-        double elastic_energy; ///< J/m (0 for the rigid wall)
+        double elastic_energy; ///< stored energy, J/m (0 for the rigid wall)
       };
 
       Upper upper_state(const dem::ParticleSystem &s, const std::vector<double> &power) const
@@ -302,62 +286,20 @@ namespace tribo::app
             return {b.position.y(), b.velocity.y(), b.position.y() - upper_y_to_surface, power[upper],
                     b.kinetic_energy(), 0.0};
           }
-#ifdef TRIBO_WITH_FEM
-        const unsigned int n = elastic->n_boundary_nodes();
-        double             vy = 0;
-        for (unsigned int i = 0; i < n; ++i)
-          vy += elastic->boundary_velocity(i).y() / n;
-        const double y = elastic->parameters().bottom + elastic->mean_bottom_displacement_y();
-        return {y, vy, y - upper_y_to_surface, elastic->load_power(), elastic->kinetic_energy(),
-                elastic->elastic_energy()};
-#else
-        return {};
-#endif
+        const double y = body->mean_bottom_y();
+        return {y, body->mean_bottom_vy(), y - upper_y_to_surface, body->external_power(), body->kinetic_energy(),
+                body->stored_energy()};
       }
 
-      /// The deal.II upper body with its bottom face at @p bottom (m).
+      /// The deformable upper body with its bottom face at @p bottom (m).
       void build_deformable_upper_body(double bottom)
       {
-#ifdef TRIBO_WITH_FEM
-        const auto  &k    = prm.shear;
-        const double cell = k.upper_cell_size > 0 ? k.upper_cell_size : k.mean_diameter * (1 - k.diameter_spread);
-        fem::ElasticBodyParameters e;
-        e.length             = k.length;
-        e.thickness          = k.upper_body_thickness;
-        e.youngs_modulus     = k.upper_youngs_modulus;
-        e.poisson_ratio      = k.upper_poisson_ratio;
-        e.density            = k.density;
-        e.cells_x            = std::max(1L, std::lround(k.length / cell));
-        e.cells_y            = std::max(1L, std::lround(k.upper_body_thickness / cell));
-        if (double(e.cells_x) * e.cells_y > 4e6)
-          throw InputError("entry 'Shear cell/Upper body cell size' = '" + to_text(k.upper_cell_size) +
-                           "': expected a cell size giving at most 4e6 cells; " + to_text(cell) +
-                           " m gives " + to_text(double(e.cells_x) * e.cells_y) + " cells");
-        e.degree             = k.upper_degree;
-        e.rayleigh_mass      = k.upper_mass_damping;
-        e.rayleigh_stiffness = k.upper_stiffness_damping;
-        e.theta              = prm.theta;
-        e.time_step          = prm.time_step;
-        e.top_pressure       = k.pressure;
-        e.pressure_ramp_time = k.ramp_time;
-        e.top_fixed_in_x     = true;
-        half_disc_diameter   = k.half_disc_diameter > 0 ? k.half_disc_diameter : k.length / e.cells_x;
-        e.bottom             = bottom + 0.5 * half_disc_diameter;
+        const auto                   &k = prm.shear;
+        coupling::FirstBodyParameters b = first_body_parameters(prm);
+        half_disc_diameter   = k.half_disc_diameter > 0 ? k.half_disc_diameter : k.length / coupling::chain_nodes(b);
+        b.bottom             = bottom + 0.5 * half_disc_diameter;
         upper_y_to_surface   = 0.5 * half_disc_diameter;
-        if (k.shear_start > 0 && k.upper_compaction_damping > 0)
-          {
-            // Before Shear start: b + 2 zeta / omega_1, omega_1 = pi c_p / (2 H).
-            const double nu = e.poisson_ratio, E = e.youngs_modulus;
-            const double c_p = std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu) * e.density));
-            e.rayleigh_stiffness += 2 * k.upper_compaction_damping / (M_PI * c_p / (2 * e.thickness));
-          }
-        elastic              = std::make_unique<fem::ElasticBody>(e);
-        boundary             = std::make_unique<coupling::ElasticBoundary>(*elastic);
-#else
-        (void)bottom;
-        throw InputError("Shear cell/Upper body model = fem needs the deformable body module, "
-                         "which this build left out (TRIBO_WITH_FEM=OFF)");
-#endif
+        body                 = coupling::make_first_body(b);
       }
 
       double draw_diameter()
@@ -408,10 +350,7 @@ namespace tribo::app
       /// touch: the upper wall's mean disc radius, or the half-disc radius.
       double                         upper_y_to_surface = 0;
       double                         half_disc_diameter = 0;
-#ifdef TRIBO_WITH_FEM
-      std::unique_ptr<fem::ElasticBody>          elastic;
-      std::unique_ptr<coupling::ElasticBoundary> boundary;
-#endif
+      std::unique_ptr<coupling::FirstBody> body; ///< deformable upper body, if any
       std::unique_ptr<LayerProfiles> profiles;
       SteadyState                    steady;
     };

@@ -64,6 +64,12 @@ namespace tribo::dem
     virtual double external_power() const = 0;
     /// Power dissipated inside the body (damping) over the last step, W/m (>= 0).
     virtual double internal_dissipation() const = 0;
+    /// Work the impulses did on the body over the last step beyond R . (v_begin + v_end)/2
+    /// with v_begin = node_velocity() read after predict(), / h, W/m: 0 for a body that
+    /// takes the impulses into its own implicit step (fem); the stored-energy change of
+    /// the position correction of an explicit particle body
+    /// (coupling/particle_first_body.h). Booked with the contact power.
+    virtual double impulse_extra_power() const { return 0; }
   };
 
   /// Placement and contacts of the half-disc elements on a BoundaryBody's chain.

@@ -212,6 +212,7 @@ namespace tribo::dem
             const Vec2 v_mid = 0.5 * (node_v_begin[i] + boundary->node_velocity(i));
             report.power_contacts += node_impulse[i].dot(v_mid) / h;
           }
+        report.power_contacts += boundary->impulse_extra_power();
         report.power_external += boundary->external_power();
         report.boundary_energy      = boundary->energy();
         report.boundary_dissipation = boundary->internal_dissipation();

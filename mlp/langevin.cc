@@ -56,6 +56,14 @@ namespace tribo::mlp
       }
   }
 
+  void LangevinIntegrator::set_damping(double eta)
+  {
+    if (!(eta >= 0))
+      throw InputError("MLP Langevin: damping must be >= 0, got eta = " + to_text(eta) + " kg/(m s)");
+    prm.damping = eta;
+    decay.clear(); // prepare() again at the next step
+  }
+
   void LangevinIntegrator::check_finite(const Particles &particles, double time)
   {
     for (unsigned int i = 0; i < particles.size(); ++i)
@@ -103,7 +111,9 @@ namespace tribo::mlp
           if (!(particles.fixed[i] & (1u << c)))
             {
               double &v = particles.velocity[i][c];
+              const double before = v;
               v         = decay[i] * v + (noisy ? kick[i] * rng.normal() : 0.0);
+              to_bath += 0.5 * particles.mass[i] * (before * before - v * v);
             }
     for (unsigned int i = 0; i < n; ++i)
       {

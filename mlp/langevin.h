@@ -52,6 +52,12 @@ namespace tribo::mlp
     void step(Particles &particles, const Box &box);
     /// Advances by @p n steps.
     void run(Particles &particles, const Box &box, unsigned int n);
+    /// Change the damping eta (kg/(m s), >= 0) for the following steps.
+    void set_damping(double eta);
+    /// Energy given to the heat bath by the O steps since construction, J/m:
+    /// sum of the kinetic-energy drops of the O steps (> 0 for friction at T = 0;
+    /// the noise gives energy back at T > 0).
+    double bath_work() const { return to_bath; }
     /// Forces are recomputed before the next step (call after moving particles
     /// or changing loads by hand).
     void invalidate_forces() { forces_current = false; }
@@ -78,6 +84,7 @@ namespace tribo::mlp
     bool                forces_current = false;
     double              t              = 0;
     unsigned long long  steps          = 0;
+    double              to_bath        = 0;
 
     void prepare(const Particles &particles);
   };

@@ -161,10 +161,9 @@ namespace tribo::sph
       }
     for (const auto &iv : imposed)
       for (unsigned int i : iv.particles)
-        {
-          k.dv[i] = Tensor<1, dim>();
-          k.dx[i] = s.v[i];
-        }
+        for (unsigned int c = 0; c < dim; ++c)
+          if (iv.components & (1u << c))
+            k.dv[i][c] = 0;
   }
 
   template <int dim>
@@ -205,18 +204,25 @@ namespace tribo::sph
   {
     for (const auto &iv : imposed)
       for (unsigned int i : iv.particles)
-        s.v[i] = iv.field ? iv.field(s.x[i], t) : iv.velocity;
+        {
+          const Tensor<1, dim> v = iv.field ? iv.field(s.x[i], t) : iv.velocity;
+          for (unsigned int c = 0; c < dim; ++c)
+            if (iv.components & (1u << c))
+              s.v[i][c] = v[c];
+        }
   }
 
   template <int dim>
-  void Solver<dim>::apply_damping(ParticleState<dim> &s, double dt) const
+  void Solver<dim>::apply_damping(ParticleState<dim> &s, double dt)
   {
     if (damping.empty())
       return;
     std::vector<char> fixed(s.size(), 0);
     for (const auto &iv : imposed)
-      for (unsigned int i : iv.particles)
-        fixed[i] = 1;
+      if (iv.components == (1u << dim) - 1)
+        for (unsigned int i : iv.particles)
+          fixed[i] = 1;
+    const double kinetic_before = s.kinetic_energy();
     for (const auto &d : damping)
       {
         Tensor<1, dim> p;
@@ -238,6 +244,7 @@ namespace tribo::sph
           if (s.body[i] == d.body && !fixed[i])
             s.v[i] = vcm + f * (s.v[i] - vcm);
       }
+    damped_energy += kinetic_before - s.kinetic_energy();
   }
 
   template <int dim>

@@ -42,12 +42,15 @@ namespace tribo::sph
   /// horizontally, the bottom layer fixed with velocity 0): v_i = velocity,
   /// dv_i/dt = 0, x_i moves with the imposed velocity. They are not damped.
   /// If @p field is set, the velocity is field(x_i, t) instead (e.g. a rigid
-  /// rotation), re-evaluated at each Runge-Kutta stage.
+  /// rotation), re-evaluated at each Runge-Kutta stage. Only the components whose
+  /// bit is set in @p components are imposed (bit c for component c; e.g. 1: x held,
+  /// the others free); particles with some component free are damped.
   template <int dim>
   struct ImposedVelocity
   {
     std::vector<unsigned int> particles;
     Tensor<1, dim>            velocity; ///< m/s
+    unsigned int              components = (1u << dim) - 1; ///< imposed components (bit mask)
     std::function<Tensor<1, dim>(const Tensor<1, dim> &x, double t)> field;
   };
 
@@ -163,13 +166,15 @@ namespace tribo::sph
 
     /// Sum of m (|v|^2/2 + e), J: conserved without damping, boundary or external forces.
     double total_energy() const { return state.kinetic_energy() + state.internal_energy(); }
+    /// Kinetic energy removed by the Damping terms since construction, J (>= 0).
+    double damping_dissipation() const { return damped_energy; }
 
     /// "particle i (x = (..), v = (..), rho = ..)" for error messages.
     std::string describe_particle(const ParticleState<dim> &s, unsigned int i) const;
 
   private:
     void apply_imposed(ParticleState<dim> &s, double t) const;
-    void apply_damping(ParticleState<dim> &s, double dt) const;
+    void apply_damping(ParticleState<dim> &s, double dt);
     void check_finite(const ParticleState<dim> &s, const std::string &where) const;
 
     std::vector<Material> mats;
@@ -178,6 +183,7 @@ namespace tribo::sph
     Rates<dim>            k1, k2;
     ParticleState<dim>    mid;
     std::string           limiter;
+    double                damped_energy = 0; ///< J, see damping_dissipation()
   };
 
   /// SPH interpolation at the particles, f~_i = sum_j (m_j/rho_j) f_j W_ij

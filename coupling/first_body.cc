@@ -1,0 +1,146 @@
+#include "coupling/first_body.h"
+
+#include "core/errors.h"
+
+#include <cmath>
+#include <sstream>
+
+#ifdef TRIBO_WITH_FEM
+#include "coupling/elastic_boundary.h"
+#endif
+
+namespace tribo::coupling
+{
+#ifdef TRIBO_WITH_SPH
+  std::unique_ptr<FirstBody> make_sph_first_body(const FirstBodyParameters &p);
+#endif
+#ifdef TRIBO_WITH_MLP
+  std::unique_ptr<FirstBody> make_mlp_first_body(const FirstBodyParameters &p);
+#endif
+
+  unsigned int chain_nodes(const FirstBodyParameters &p)
+  {
+    const long n = std::lround(p.length / p.resolution);
+    if (p.model == "fem")
+      return std::max(1L, n);
+    if (p.model == "sph")
+      return std::max(8L, n);
+    if (p.model == "mlp")
+      return std::max(4L, n);
+    throw InputError("unknown upper body model '" + p.model + "': expected rigid, fem, sph or mlp");
+  }
+
+  double p_wave_speed(const FirstBodyParameters &p)
+  {
+    const double E = p.youngs_modulus, nu = p.poisson_ratio;
+    return std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu) * p.density));
+  }
+
+  void check_first_body(const FirstBodyParameters &p)
+  {
+    if (p.model != "sph" && p.model != "mlp")
+      return;
+    if (p.model == "mlp" && p.poisson_ratio > 0.25 + 1e-12)
+      throw InputError("entry 'Shear cell/Upper body Poisson ratio' = '" + to_text(p.poisson_ratio) +
+                       "': an mlp upper body needs nu <= 0.25 (its plane-strain 2D ratio nu/(1 - nu) must "
+                       "be <= 1/3: return forces can only lower it); use 0.25 or less, or Upper body "
+                       "model = fem or sph");
+    const double s = p.length / chain_nodes(p), c = p_wave_speed(p);
+    const double h_max = particle_coupling_courant * s / c;
+    if (p.time_step > h_max * (1 + 1e-12))
+      throw InputError("entry 'Simulation/Time step' = '" + to_text(p.time_step) + "': an " + p.model +
+                       " upper body is kicked by the contacts once per step, stable only for c_p h / s <= " +
+                       to_text(particle_coupling_courant) + "; with c_p = " + to_text(c) +
+                       " m/s and particle spacing s = " + to_text(s) + " m that is h <= " + to_text(h_max) +
+                       " s: use Simulation/Time step = " + to_text(h_max) +
+                       " or less, or a larger Shear cell/Upper body cell size");
+  }
+
+  std::string first_body_snapshot_name(unsigned int index)
+  {
+    return "upper_body_" + std::to_string(100000 + index).substr(1) + ".vtu";
+  }
+
+#ifdef TRIBO_WITH_FEM
+  std::string ElasticBoundary::describe() const
+  {
+    const auto        &e = body.parameters();
+    std::ostringstream os;
+    os << "fem upper body: " << e.cells_x << " x " << e.cells_y << " Q" << e.degree << " cells, " << body.n_dofs()
+       << " dofs, E = " << e.youngs_modulus << " Pa, nu = " << e.poisson_ratio;
+    return os.str();
+  }
+#endif
+
+  namespace
+  {
+    [[noreturn, maybe_unused]] void left_out(const std::string &model, const std::string &option)
+    {
+      throw InputError("Shear cell/Upper body model = " + model + " needs a module this build left out (" +
+                       option + "=OFF); rebuild with -D" + option + "=ON");
+    }
+
+#ifdef TRIBO_WITH_FEM
+    std::unique_ptr<FirstBody> make_fem_first_body(const FirstBodyParameters &p)
+    {
+      fem::ElasticBodyParameters e;
+      e.length         = p.length;
+      e.thickness      = p.thickness;
+      e.bottom         = p.bottom;
+      e.youngs_modulus = p.youngs_modulus;
+      e.poisson_ratio  = p.poisson_ratio;
+      e.density        = p.density;
+      e.cells_x        = chain_nodes(p);
+      e.cells_y        = std::max(1L, std::lround(p.thickness / p.resolution));
+      if (double(e.cells_x) * e.cells_y > 4e6)
+        throw InputError("entry 'Shear cell/Upper body cell size' = '" + to_text(p.resolution) +
+                         "': expected a cell size giving at most 4e6 cells; it gives " +
+                         to_text(double(e.cells_x) * e.cells_y) + " cells");
+      e.degree             = p.degree;
+      e.rayleigh_mass      = p.rayleigh_mass;
+      e.rayleigh_stiffness = p.rayleigh_stiffness;
+      e.theta              = p.theta;
+      e.time_step          = p.time_step;
+      e.top_pressure       = p.pressure;
+      e.pressure_ramp_time = p.pressure_ramp_time;
+      e.top_fixed_in_x     = true;
+      // Until shearing starts: b + 2 zeta / omega_1, omega_1 = pi c_p / (2 H).
+      if (p.compaction_damping > 0)
+        e.rayleigh_stiffness += 2 * p.compaction_damping / (M_PI * p_wave_speed(p) / (2 * e.thickness));
+      return std::make_unique<ElasticBoundary>(std::make_unique<fem::ElasticBody>(e), p.rayleigh_mass,
+                                               p.rayleigh_stiffness);
+    }
+#endif
+  } // namespace
+
+  std::unique_ptr<FirstBody> make_first_body(const FirstBodyParameters &p)
+  {
+    check_first_body(p);
+    if (p.model == "fem")
+      {
+#ifdef TRIBO_WITH_FEM
+        return make_fem_first_body(p);
+#else
+        left_out("fem", "TRIBO_WITH_FEM");
+#endif
+      }
+    if (p.model == "sph")
+      {
+#ifdef TRIBO_WITH_SPH
+        return make_sph_first_body(p);
+#else
+        left_out("sph", "TRIBO_WITH_SPH");
+#endif
+      }
+    if (p.model == "mlp")
+      {
+#ifdef TRIBO_WITH_MLP
+        return make_mlp_first_body(p);
+#else
+        left_out("mlp", "TRIBO_WITH_MLP");
+#endif
+      }
+    chain_nodes(p); // throws for an unknown model
+    return nullptr;
+  }
+} // namespace tribo::coupling

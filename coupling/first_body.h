@@ -1,0 +1,111 @@
+#pragma once
+/// @file The shear cell's deformable upper first body, whatever its model, as one kind
+/// of object: the solver's coupling interface (dem::BoundaryBody, ../shared/DESIGN.md
+/// section 3) plus what the scene measures, writes and checkpoints.
+///
+/// Models (Shear cell/Upper body model):
+/// - fem: the deal.II plane-strain body (fem/), implicit Moreau-Jean, its bottom face
+///   condensed onto its contact nodes (coupling/elastic_boundary.h);
+/// - sph: a solid SPH block (sph/) on a square lattice, linear equation of state;
+/// - mlp: a movable-lattice-particle block (mlp/) on a hexagonal lattice.
+/// The particle models are explicit: their bottom row of particles is the contact chain
+/// and they sub-cycle inside a contact step (coupling/particle_first_body.h).
+///
+/// All share: period L along x, thickness H, bottom face (the chain) at y0, top face
+/// held in x and loaded by the pressure P(t) = P min(1, t / ramp) (compressive), and a
+/// compaction damping of ratio zeta on the first thickness mode until start_shearing().
+/// Units per unit depth: m, kg/m, N/m, J/m, W/m.
+
+#include "core/checkpoint.h"
+#include "dem/boundary.h"
+
+#include <memory>
+#include <string>
+
+namespace tribo::coupling
+{
+  /// Geometry, material and loading of an upper first body (SI units).
+  struct FirstBodyParameters
+  {
+    std::string  model = "fem"; ///< fem | sph | mlp
+    double       length = 0;    ///< L: period along x, m
+    double       thickness = 0; ///< H, m
+    double       bottom = 0;    ///< y0 of the bottom face (the contact chain), m
+    double       youngs_modulus = 0; ///< E, Pa
+    double       poisson_ratio = 0;  ///< nu (plane strain)
+    double       density = 0;        ///< rho, kg/m^3
+    /// Cell size (fem) or particle spacing (sph, mlp), m: the chain has
+    /// chain_nodes() = max(minimum, round(L / resolution)) nodes.
+    double       resolution = 0;
+    unsigned int degree = 1;            ///< Q_p degree (fem)
+    double       rayleigh_mass = 0;      ///< a of C = a M + b K while shearing, 1/s (fem)
+    double       rayleigh_stiffness = 0; ///< b, s (fem)
+    double       theta = 0.5;            ///< Moreau-Jean theta (fem)
+    double       time_step = 0;          ///< contact step h, s
+    double       pressure = 0;           ///< P, Pa (> 0: compressive)
+    double       pressure_ramp_time = 0; ///< s; 0: a step at t = 0
+    /// Damping ratio zeta of the first thickness mode, omega_1 = pi c_p / (2 H), until
+    /// start_shearing() (0: none). fem: stiffness-proportional b_c = 2 zeta / omega_1;
+    /// particles: damping of every particle's velocity towards rest at
+    /// gamma = 2 zeta omega_1 (1/s), which also caps the compaction stroke at the
+    /// terminal speed P / (rho H gamma) (0.9 m/s for the paper's steel body at zeta = 1,
+    /// as the rigid wall's Compaction speed limit does; an explicit particle chain hit
+    /// at tens of m/s lets grains through).
+    double       compaction_damping = 0;
+    /// Smoothing length over spacing (sph).
+    double       smoothing_ratio = 1.2;
+  };
+
+  /// Number of chain nodes the model places along L for @p p (fem: cells along x;
+  /// sph: at least 8 columns, the kernel support must fit 3 times in the period;
+  /// mlp: at least 4 columns). Throws InputError for an unknown model.
+  unsigned int chain_nodes(const FirstBodyParameters &p);
+
+  /// P-wave speed of the plane-strain material, sqrt(E (1 - nu) / ((1 + nu)(1 - 2 nu) rho)), m/s.
+  double p_wave_speed(const FirstBodyParameters &p);
+
+  /// An upper first body: the coupling interface plus the scene's measurements.
+  class FirstBody : public dem::BoundaryBody
+  {
+  public:
+    /// Mean y of the chain nodes at the start of the next step, m.
+    virtual double mean_bottom_y() const = 0;
+    /// Mean y-velocity of the chain nodes, m/s.
+    virtual double mean_bottom_vy() const = 0;
+    /// J/m.
+    virtual double kinetic_energy() const = 0;
+    /// Energy stored in the body, J/m: elastic (fem), internal (sph: elastic work plus
+    /// the heat of its artificial viscosity), potential (mlp).
+    virtual double stored_energy() const = 0;
+    /// Kinetic plus stored energy, J/m.
+    double energy() const final { return kinetic_energy() + stored_energy(); }
+    /// Drop the compaction damping (the shearing phase starts).
+    virtual void start_shearing() = 0;
+    /// Write a VTU snapshot with index @p index into directory @p dir; returns its file
+    /// name (upper_body_NNNNN.vtu).
+    virtual std::string write_fields(const std::string &dir, unsigned int index) const = 0;
+    /// One line for the log: model, resolution, counts.
+    virtual std::string describe() const = 0;
+    virtual void save(CheckpointOut &ar) const = 0;
+    virtual void load(CheckpointIn &ar) = 0;
+  };
+
+  /// Largest c_p h / s (P-wave speed times contact step over particle spacing) at which
+  /// an sph or mlp body is coupled: its chain particles are kicked once per contact step,
+  /// which is stable only if the step resolves their own vibration (measured on the
+  /// 120-disc cell, mlp: worst overlap 0.2 r at 0.78, 0.7 r at 1.5, grains driven
+  /// through the chain at 3.9; docs/first_bodies.md).
+  constexpr double particle_coupling_courant = 1.0;
+
+  /// Throws InputError, naming the case entry and a value that would work, if @p p
+  /// cannot run: for sph and mlp a contact step above the coupling limit
+  /// (particle_coupling_courant), for mlp a Poisson ratio above 1/4.
+  void check_first_body(const FirstBodyParameters &p);
+
+  /// The body of model p.model (check_first_body() first). Throws InputError for a model this build left out
+  /// (naming the CMake option) or bad parameters.
+  std::unique_ptr<FirstBody> make_first_body(const FirstBodyParameters &p);
+
+  /// "upper_body_NNNNN.vtu" for snapshot @p index.
+  std::string first_body_snapshot_name(unsigned int index);
+} // namespace tribo::coupling

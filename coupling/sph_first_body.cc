@@ -1,0 +1,174 @@
+// The SPH upper first body: a solid SPH block (sph/) behind the coupling interface.
+#include "coupling/particle_first_body.h"
+
+#include "core/errors.h"
+#include "core/output.h"
+#include "core/point_cloud.h"
+#include "sph/lattice.h"
+#include "sph/solver.h"
+
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+
+#include <cmath>
+#include <sstream>
+
+namespace tribo::coupling
+{
+  namespace
+  {
+    using sph::Tensor;
+
+    /// A plane-strain SPH block of nx x ny particles on a square lattice of spacing
+    /// s = L / nx (mass rho s^2, smoothing length ratio x s), linear equation of
+    /// state P = K (rho / rho0 - 1) with K = E / (3 (1 - 2 nu)), shear modulus
+    /// G = E / (2 (1 + nu)), Monaghan viscosity (alpha 1, beta 0.1), periodic in x.
+    /// The bottom row is the chain at y0; the top row carries the load and is held in x.
+    /// Compaction damping: the SPH damping towards rest (not relative to the centre of
+    /// mass), which also caps the body's landing speed on the layer.
+    class SphFirstBody : public ParticleFirstBody
+    {
+    public:
+      explicit SphFirstBody(const FirstBodyParameters &p)
+        : ParticleFirstBody(p)
+        , solver({sph::Material::linear(p.density, p.youngs_modulus / (3 * (1 - 2 * p.poisson_ratio)),
+                                        p.youngs_modulus / (2 * (1 + p.poisson_ratio)))},
+                 parameters(p))
+      {
+        const unsigned int nx = chain_nodes(p);
+        spacing               = p.length / nx;
+        ny                    = std::max(2L, std::lround(p.thickness / spacing));
+        // Cell centres of [0, L) x [y0 - s/2, y0 + (ny - 1/2) s): rows at y0 + j s.
+        const auto points = sph::lattice_points<2>(sph::LatticeType::cubic, Tensor<1, 2>({0, p.bottom - 0.5 * spacing}),
+                                                   Tensor<1, 2>({p.length, ny * spacing}), spacing);
+        sph::add_particles(solver.state, points, p.density, spacing * spacing, p.smoothing_ratio * spacing, 0, 0);
+        std::vector<unsigned int> bottom, top_row;
+        for (unsigned int i = 0; i < solver.state.size(); ++i)
+          {
+            const double y = solver.state.x[i][1];
+            if (y < p.bottom + 0.5 * spacing)
+              bottom.push_back(i);
+            if (y > p.bottom + (ny - 1.5) * spacing)
+              top_row.push_back(i);
+          }
+        if (bottom.size() != nx || top_row.size() != nx)
+          throw std::logic_error("SPH first body: lattice rows of " + std::to_string(bottom.size()) + " and " +
+                                 std::to_string(top_row.size()) + " particles, expected " + std::to_string(nx));
+        set_rows(bottom, top_row);
+
+        sph::ImposedVelocity<2> hold;
+        hold.particles  = top_row;
+        hold.components = 1; // x held, y free
+        solver.imposed.push_back(hold);
+        sph::ExternalForce<2> load;
+        load.particles = top_row;
+        solver.external.push_back(load);
+        if (p.compaction_damping > 0)
+          {
+            sph::Damping d{0, 2 * p.compaction_damping * M_PI * p_wave_speed(p) / (2 * p.thickness)};
+            d.relative_to_centre_of_mass = false; // towards rest: also caps the landing speed
+            solver.damping.push_back(d);
+          }
+      }
+
+      std::string describe() const override
+      {
+        std::ostringstream os;
+        os << "sph upper body: " << solver.state.size() << " particles (" << n_nodes() << " x " << ny
+           << ", spacing " << spacing << " m, h = " << prm.smoothing_ratio << " s), E = " << prm.youngs_modulus
+           << " Pa, nu = " << prm.poisson_ratio << ", c_p = " << p_wave_speed(prm) << " m/s";
+        return os.str();
+      }
+
+      double stored_energy() const override { return solver.state.internal_energy(); }
+      void   start_shearing() override { solver.damping.clear(); }
+
+      std::string write_fields(const std::string &dir, unsigned int index) const override
+      {
+        const auto        &s = solver.state;
+        const unsigned int n = s.size();
+        std::vector<std::array<double, 3>> points(n);
+        PointField velocity{"velocity", 2, {}}, sxx{"sigma_xx", 1, {}}, syy{"sigma_yy", 1, {}},
+          sxy{"sigma_xy", 1, {}}, pressure{"pressure", 1, {}}, energy{"internal_energy", 1, {}};
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            points[i] = {{s.x[i][0], s.x[i][1], 0}};
+            const double P = solver.materials()[0].evaluate(s.rho[i], s.e[i]).pressure;
+            velocity.values.insert(velocity.values.end(), {s.v[i][0], s.v[i][1]});
+            sxx.values.push_back(s.S[i][0][0] - P);
+            syy.values.push_back(s.S[i][1][1] - P);
+            sxy.values.push_back(s.S[i][0][1]);
+            pressure.values.push_back(P);
+            energy.values.push_back(s.e[i]);
+          }
+        const std::string name = first_body_snapshot_name(index);
+        atomic_write(dir + "/" + name, point_cloud_vtu(2, points, {velocity, sxx, syy, sxy, pressure, energy}));
+        return name;
+      }
+
+      void save(CheckpointOut &ar) const override
+      {
+        const auto &s = solver.state;
+        ar << solver.time << total_dissipation() << bool(!solver.damping.empty());
+        for (unsigned int i = 0; i < s.size(); ++i)
+          ar << s.x[i][0] << s.x[i][1] << s.v[i][0] << s.v[i][1] << s.rho[i] << s.e[i] << s.S[i][0][0]
+             << s.S[i][1][1] << s.S[i][0][1];
+        save_base(ar);
+      }
+
+      void load(CheckpointIn &ar) override
+      {
+        auto  &s = solver.state;
+        double damped;
+        bool   damping_on;
+        ar >> solver.time >> damped >> damping_on;
+        dissipation_offset = damped - solver.damping_dissipation();
+        if (!damping_on)
+          solver.damping.clear();
+        for (unsigned int i = 0; i < s.size(); ++i)
+          ar >> s.x[i][0] >> s.x[i][1] >> s.v[i][0] >> s.v[i][1] >> s.rho[i] >> s.e[i] >> s.S[i][0][0] >>
+            s.S[i][1][1] >> s.S[i][0][1];
+        load_base(ar);
+      }
+
+    protected:
+      unsigned int n_particles() const override { return solver.state.size(); }
+      dem::Vec2    position(unsigned int p) const override { return {solver.state.x[p][0], solver.state.x[p][1]}; }
+      dem::Vec2    velocity(unsigned int p) const override { return {solver.state.v[p][0], solver.state.v[p][1]}; }
+      double       mass(unsigned int p) const override { return solver.state.mass[p]; }
+      void         kick(unsigned int p, const dem::Vec2 &dv, const dem::Vec2 &dx) override
+      {
+        auto &s = solver.state;
+        s.v[p][0] += dv.x();
+        s.v[p][1] += dv.y();
+        s.x[p][0] += dx.x();
+        s.x[p][1] += dx.y();
+        s.x[p][0] -= prm.length * std::floor(s.x[p][0] / prm.length);
+      }
+      unsigned int advance(double h, double load) override
+      {
+        solver.external[0].force = Tensor<1, 2>({0, load});
+        return solver.advance_to(solver.time + h);
+      }
+      double total_dissipation() const override { return dissipation_offset + solver.damping_dissipation(); }
+
+    private:
+      static sph::SolverParameters parameters(const FirstBodyParameters &p)
+      {
+        sph::SolverParameters s;
+        s.period = p.length;
+        return s;
+      }
+
+      sph::Solver<2> solver;
+      double         spacing = 0;
+      long           ny      = 0;
+      double         dissipation_offset = 0; ///< J/m, restored from a checkpoint
+    };
+  } // namespace
+
+  std::unique_ptr<FirstBody> make_sph_first_body(const FirstBodyParameters &p)
+  {
+    return std::make_unique<SphFirstBody>(p);
+  }
+} // namespace tribo::coupling

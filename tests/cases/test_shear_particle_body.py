@@ -1,0 +1,121 @@
+#!/usr/bin/python3
+"""The shear cell with a movable-lattice-particle (MLP) upper body, coupled through its
+bottom row of particles (coupling/particle_first_body.h), on the 120-disc sample of
+test_shear_physics.py: compaction until 7 us, then 0.6 us of shear, contact step
+4e-10 s (c_p h / s = 0.78 for s = 2 um, under the coupling limit of 1):
+
+- equilibrium: the mean normal force on the lower wall while shearing is P L;
+- energy: every step while shearing, the grains' kinetic energy plus the body's kinetic
+  and potential energy change by h (power_external + power_contacts -
+  power_damping_upper_body) within 5 % of the step's mean |work|, and over the window
+  within 1 % of the summed |work|; the compaction damping works before Shear start
+  and is gone after;
+- the body stores elastic energy and its chain holds the grains (worst overlap below
+  half a grain radius);
+- the step guard: a step above the coupling limit and a Poisson ratio above 1/4 are
+  refused before anything is written, naming the entry and a value that works.
+
+Usage: test_shear_particle_body.py PATH/TO/tribo
+"""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import test_shear_physics as base  # noqa: E402  (the case text)
+
+TRIBO = None
+P, L = base.P, base.L
+H = 4e-10
+SHEAR_START = 7e-6
+MLP = ["--set", "Shear cell/Upper body model=mlp", "--set", "Shear cell/Upper body Poisson ratio=0.25",
+       "--set", "Shear cell/Upper body cell size=2e-6", "--set", f"Simulation/Time step={H}"]
+
+
+def write_case(directory):
+    case = os.path.join(directory, "case.prm")
+    with open(case, "w") as f:
+        f.write(base.CASE)
+    return case
+
+
+class MlpUpperBody(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        case = write_case(cls.tmp.name)
+        cls.out = os.path.join(cls.tmp.name, "mlp")
+        subprocess.run([TRIBO, "run", case, "--output", cls.out, "--quiet"] + MLP +
+                       ["--set", f"Shear cell/Shear start={SHEAR_START}", "--set", "Simulation/End time=7.6e-6",
+                        "--set", "Output/Statistics interval=1"], check=True, timeout=400)
+        cls.st = np.genfromtxt(os.path.join(cls.out, "statistics.csv"), delimiter=",", names=True)
+        with open(os.path.join(cls.out, "log.txt")) as f:
+            cls.log = f.read()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_body_is_described_in_the_log(self):
+        self.assertIn("mlp upper body: 522 particles (6 x 87 hexagonal, spacing 2e-06 m)", self.log)
+
+    def test_normal_force_is_P_L_while_shearing(self):
+        st = self.st
+        shearing = st["time"] > SHEAR_START + 1e-7
+        self.assertAlmostEqual(st["lower_wall_normal_force"][shearing].mean() / (P * L), 1.0, delta=0.03)
+
+    def test_energy_balance_every_step(self):
+        st = self.st
+        energy = st["kinetic_energy"] + st["kinetic_energy_upper_wall"] + st["elastic_energy_upper_body"]
+        change = np.diff(energy)
+        work = H * (st["power_external"] + st["power_contacts"] - st["power_damping_upper_body"])[1:]
+        # The step where the lower wall is set to V is excluded (its jump is not a work).
+        keep = st["time"][1:] > SHEAR_START + 2 * H
+        scale = np.abs(work[keep]).mean()
+        self.assertLess(np.abs(change[keep] - work[keep]).max(), 0.05 * scale)
+        self.assertLess(abs((change[keep] - work[keep]).sum()), 0.01 * np.abs(work[keep]).sum())
+
+    def test_compaction_damping_then_none(self):
+        st = self.st
+        self.assertGreater(st["power_damping_upper_body"][st["time"] < SHEAR_START - 1e-7].max(), 0)
+        self.assertEqual(np.abs(st["power_damping_upper_body"][st["time"] > SHEAR_START + H]).max(), 0)
+
+    def test_body_is_loaded_and_holds_the_grains(self):
+        st = self.st
+        self.assertGreater(st["elastic_energy_upper_body"][-1], 0)
+        self.assertLess(st["max_overlap"].max(), 0.5 * 0.5 * 1.2e-6 * 0.8)
+
+
+class Guards(unittest.TestCase):
+    def run_refused(self, extra):
+        with tempfile.TemporaryDirectory() as tmp:
+            case = write_case(tmp)
+            out = os.path.join(tmp, "out")
+            p = subprocess.run([TRIBO, "run", case, "--output", out, "--quiet"] + extra,
+                               capture_output=True, text=True, timeout=60)
+            self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+            self.assertFalse(os.path.exists(out))
+            return p.stderr
+
+    def test_a_step_above_the_coupling_limit_is_refused(self):
+        err = self.run_refused(MLP[:-2] + ["--set", "Simulation/Time step=2e-9"])
+        self.assertIn("case.prm: entry 'Simulation/Time step' = '2e-09': an mlp upper body is kicked by the "
+                      "contacts once per step, stable only for c_p h / s <= 1", err)
+        self.assertIn("that is h <= 5.09902e-10 s: use Simulation/Time step = 5.09902e-10 or less", err)
+
+    def test_a_poisson_ratio_above_one_quarter_is_refused(self):
+        err = self.run_refused(["--set", "Shear cell/Upper body model=mlp"])
+        self.assertIn("entry 'Shear cell/Upper body Poisson ratio' = '0.33': an mlp upper body needs nu <= 0.25",
+                      err)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit("usage: test_shear_particle_body.py PATH/TO/tribo")
+    TRIBO = os.path.abspath(sys.argv.pop(1))
+    unittest.main(verbosity=2)
