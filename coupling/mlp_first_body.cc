@@ -70,7 +70,17 @@ namespace tribo::coupling
         return os.str();
       }
 
-      double stored_energy() const override { return forces.potential_energy(particles, box) - reference_energy; }
+      /// Potential energy above the unloaded lattice's, J/m (one pair pass, cached until
+      /// the particles move).
+      double stored_energy() const override
+      {
+        if (!potential_current)
+          {
+            potential         = forces.potential_energy(particles, box) - reference_energy;
+            potential_current = true;
+          }
+        return potential;
+      }
       void   start_shearing() override
       {
         if (gamma == 0)
@@ -111,6 +121,7 @@ namespace tribo::coupling
         for (unsigned int i = 0; i < particles.size(); ++i)
           ar >> particles.position[i].x() >> particles.position[i].y() >> particles.velocity[i].x() >>
             particles.velocity[i].y();
+        potential_current = false;
         build_integrator(prm.time_step);
         dissipation_offset = damped - integrator->bath_work();
         load_base(ar);
@@ -126,6 +137,7 @@ namespace tribo::coupling
         particles.velocity[p] += dv;
         particles.position[p] = box.wrap(particles.position[p] + dx);
         integrator->invalidate_forces();
+        potential_current = false;
       }
       unsigned int advance(double h, double load) override
       {
@@ -139,6 +151,7 @@ namespace tribo::coupling
             integrator->invalidate_forces();
           }
         integrator->run(particles, box, substeps_per_step);
+        potential_current = false;
         return substeps_per_step;
       }
       double total_dissipation() const override { return dissipation_offset + integrator->bath_work(); }
@@ -182,6 +195,8 @@ namespace tribo::coupling
       double       dissipation_offset = 0;
       double       reference_energy   = NAN; ///< U of the unloaded lattice (-D per bond), J/m
       long         ny                 = 0;
+      mutable double potential         = 0;     ///< cache of stored_energy()
+      mutable bool   potential_current = false;
       unsigned int substeps_per_step  = 1;
     };
   } // namespace
