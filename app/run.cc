@@ -72,36 +72,38 @@ namespace tribo::app
       for (const std::string &file : scene.write_fields(writer.directory(), writer.n_snapshots() - 1))
         writer.index(file.substr(0, file.rfind('_')), t, file);
     }
-    /// What a resumed run may change: how it solves and what it writes, and how long it
-    /// runs. Anything else (the scene, the law, the loading) would not continue the same
-    /// run.
-    bool may_change_on_resume(const std::string &entry)
-    {
-      return entry.rfind("Solver/", 0) == 0 || entry.rfind("Output/", 0) == 0 ||
-             entry == "Simulation/End time";
-    }
-
-    /// The entries that differ between the checkpoint's parameters and the case's, as a
-    /// log text; an InputError for one that may not change.
-    std::string changed_entries(const std::map<std::string, std::string> &saved,
-                                const std::map<std::string, std::string> &now, const std::string &dir)
-    {
-      std::string changes;
-      for (const auto &[entry, value] : now)
-        {
-          const auto it = saved.find(entry);
-          const std::string before = it == saved.end() ? "(absent)" : it->second;
-          if (before == value)
-            continue;
-          if (!may_change_on_resume(entry))
-            throw InputError("--resume " + dir + ": entry '" + entry + "' is '" + value +
-                             "' in the case but '" + before + "' in the checkpoint; a resumed run "
-                             "may change only Solver/*, Output/* and Simulation/End time");
-          changes += (changes.empty() ? "; changed: " : ", ") + entry + " " + before + " -> " + value;
-        }
-      return changes;
-    }
   } // namespace
+
+  bool may_change_on_resume(const std::string &entry)
+  {
+    return entry.rfind("Solver/", 0) == 0 || entry.rfind("Output/", 0) == 0 ||
+           entry == "Simulation/End time";
+  }
+
+  std::string resume_changes(const std::map<std::string, std::string> &saved,
+                             const ParameterFile &now, const std::string &dir)
+  {
+    std::string changed, defaulted;
+    for (const auto &[entry, value] : now.resolved())
+      {
+        const auto        it     = saved.find(entry);
+        const std::string before = it == saved.end() ? "(absent)" : it->second;
+        if (before == value)
+          continue;
+        if (it == saved.end() && now.is_default(entry))
+          {
+            defaulted += (defaulted.empty() ? "" : ", ") + entry + " = " + value;
+            continue;
+          }
+        if (!may_change_on_resume(entry))
+          throw InputError("--resume " + dir + ": entry '" + entry + "' is '" + value +
+                           "' in the case but '" + before + "' in the checkpoint; a resumed run "
+                           "may change only Solver/*, Output/* and Simulation/End time");
+        changed += (changed.empty() ? "" : ", ") + entry + " " + before + " -> " + value;
+      }
+    return (changed.empty() ? "" : "; changed: " + changed) +
+           (defaulted.empty() ? "" : "; not in the checkpoint, at their defaults: " + defaulted);
+  }
 
   bool is_sph_scene(const std::string &scene) { return scene.rfind("sph_", 0) == 0; }
   bool is_mlp_scene(const std::string &scene) { return scene.rfind("mlp_", 0) == 0; }
@@ -206,7 +208,7 @@ namespace tribo::app
         [&](CheckpointIn &ar) {
           std::map<std::string, std::string> saved;
           ar >> saved;
-          changes = changed_entries(saved, resolved, o.resume_dir);
+          changes = resume_changes(saved, file, o.resume_dir);
         },
         false);
     if (!resuming)

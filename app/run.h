@@ -2,12 +2,14 @@
 /// @file `tribo run` and `tribo check`: read a case, build its scene, step it,
 /// and write the output directory (docs/outputs.md).
 
+#include <map>
 #include <string>
 #include <vector>
 
 namespace tribo
 {
-  class Log; // core/output.h
+  class Log;           // core/output.h
+  class ParameterFile; // core/parameter_file.h
 }
 
 namespace tribo::app
@@ -35,6 +37,19 @@ namespace tribo::app
   /// The "status" of DIR/summary.json (running, complete, interrupted, failed), or "" if
   /// there is none or it cannot be read.
   std::string run_status(const std::string &dir);
+
+  /// What a resumed run may change: how it solves and what it writes, and how long it
+  /// runs ("Solver/*", "Output/*", "Simulation/End time"). Anything else (the scene, the
+  /// law, the loading) would not continue the same run.
+  bool may_change_on_resume(const std::string &entry);
+
+  /// The entries of @p now that differ from @p saved (the checkpoint's resolved
+  /// parameters), as a log text "; changed: A x -> y, ..."; InputError naming the entry
+  /// and @p dir for one that may not change. An entry the checkpoint does not have
+  /// (declared by a later version of the program) is accepted when @p now leaves it at
+  /// its default, which is how the program that wrote the checkpoint behaved.
+  std::string resume_changes(const std::map<std::string, std::string> &saved,
+                             const ParameterFile &now, const std::string &dir);
 
   /// The full documented parameter tree with defaults (`tribo params`).
   std::string parameter_reference();

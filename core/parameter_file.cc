@@ -225,6 +225,11 @@ namespace tribo
     return file + " (default)";
   }
 
+  bool ParameterFile::is_default(const std::string &path) const
+  {
+    return !overridden.count(path) && !lines.count(path);
+  }
+
   void ParameterFile::fail(const std::string &path, const std::string &expected) const
   {
     throw InputError(where(path) + ": entry '" + path + "' = '" + get(path) + "': expected " +

@@ -51,6 +51,8 @@ namespace tribo
 
     /// Where @p path was set: "FILE:LINE", "--set" or "FILE (default)".
     std::string where(const std::string &path) const;
+    /// True when @p path was set neither in the file nor by set(): it has its default.
+    bool is_default(const std::string &path) const;
 
     const std::string &filename() const { return file; }
     /// The file exactly as read.
