@@ -118,6 +118,9 @@ namespace tribo::app
     prm.declare_entry("Length", "1e-4", Double(), "Period L along x, m (> 0; paper: 1e-4).");
     prm.declare_entry("Wall discs", "72", Integer(0),
                       "Discs in each rough wall, spread evenly along L (paper: 72); 0 gives L/d.");
+    prm.declare_entry("Wall disc diameter", "0", Double(0),
+                      "Diameter of every wall disc, m (>= 0); 0: drawn from the grains' distribution "
+                      "(the paper's walls).");
     prm.declare_entry("Pressure", "1e8", Double(), "Pressure P on the upper wall, Pa (> 0); force P L per unit depth.");
     prm.declare_entry("Pressure ramp time", "2e-6", Double(), "Time over which P rises linearly from 0, s (>= 0).");
     prm.declare_entry("Sliding velocity", "5", Double(), "Velocity V of the lower wall along x once shearing starts, m/s.");
@@ -241,9 +244,12 @@ namespace tribo::app
         const double d_max = sc.mean_diameter * (1 + sc.diameter_spread);
         if (sc.length < 8 * d_max)
           f.fail(S + "Length", "a length of at least 8 largest diameters (" + to_text(8 * d_max) + " m)");
-        sc.wall_discs = f.get_integer(S + "Wall discs");
-        if (sc.wall_discs > 0 && sc.wall_discs * sc.mean_diameter * (1 - sc.diameter_spread) > sc.length)
-          f.fail(S + "Wall discs", "at most " + std::to_string(int(sc.length / (sc.mean_diameter * (1 - sc.diameter_spread)))) +
+        sc.wall_discs         = f.get_integer(S + "Wall discs");
+        sc.wall_disc_diameter = f.get_double(S + "Wall disc diameter");
+        const double d_wall   = sc.wall_disc_diameter > 0 ? sc.wall_disc_diameter
+                                                          : sc.mean_diameter * (1 - sc.diameter_spread);
+        if (sc.wall_discs > 0 && sc.wall_discs * d_wall > sc.length * (1 + 1e-12))
+          f.fail(S + "Wall discs", "at most " + std::to_string(int(sc.length / d_wall * (1 + 1e-12))) +
                                      " discs, so that they fit along the length without overlapping");
         sc.pressure  = f.get_checked(S + "Pressure", positive, "a positive pressure in Pa");
         sc.ramp_time = f.get_checked(S + "Pressure ramp time", non_negative, "a time >= 0 in s");

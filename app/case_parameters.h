@@ -34,6 +34,7 @@ namespace tribo::app
     double       density;              ///< kg/m^3
     double       length;               ///< period L along x, m
     unsigned int wall_discs;           ///< discs per wall (0: L/d)
+    double       wall_disc_diameter;   ///< m; 0: drawn like the grains' diameters
     double       pressure;             ///< P, Pa; force P L (N/m) on the upper wall
     double       ramp_time;            ///< s over which P rises linearly from 0
     double       sliding_velocity;     ///< V of the lower wall along x, m/s

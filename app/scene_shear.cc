@@ -309,7 +309,8 @@ namespace tribo::app
         return k.mean_diameter * u(rng);
       }
 
-      /// A rough wall: discs of drawn sizes spread evenly along the period at height y;
+      /// A rough wall: discs of drawn sizes (or all of Shear cell/Wall disc diameter)
+      /// spread evenly along the period at height y;
       /// its mean disc diameter goes to lower_wall_diameter (both walls draw alike).
       unsigned int add_wall(dem::ParticleSystem &s, double y)
       {
@@ -320,7 +321,7 @@ namespace tribo::app
         std::vector<dem::Vec2> centres(n);
         for (unsigned int i = 0; i < n; ++i)
           {
-            radii[i]   = 0.5 * draw_diameter();
+            radii[i]   = 0.5 * (k.wall_disc_diameter > 0 ? k.wall_disc_diameter : draw_diameter());
             centres[i] = {(i + 0.5) * k.length / n, y};
           }
         const double mean_diameter = 2 * std::accumulate(radii.begin(), radii.end(), 0.0) / n;
