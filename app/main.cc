@@ -12,7 +12,7 @@
 
 namespace
 {
-  const char *usage = R"(tribo: third-body tribology simulations (NSCD rigid discs; more first-body models to come)
+  const char *usage = R"(tribo: third-body tribology simulations (NSCD discs; rigid, deal.II, SPH and MLP first bodies; SPH and MLP scenes)
 
 Usage:
   tribo run CASE.prm [--output DIR] [--set "Subsection/Entry=value" ...] [--quiet]
@@ -24,6 +24,9 @@ Usage:
       Read and validate a case without running it.
   tribo study STUDY.prm [--output DIR] [--quiet]
       Run every combination of a study (app/study.h); in parallel with mpirun -np N.
+  tribo tradeoff STUDY.prm [--output DIR] [--quiet]
+      A study with Design = tradeoff: ladders of settings, cost and error against the
+      reference in tradeoff.csv/.md/.png (docs/tradeoff.md).
   tribo params
       Print every parameter with its default, allowed values and unit: a case to start from.
   tribo --help | --version
@@ -59,9 +62,10 @@ int main(int argc, char **argv)
           std::cout << tribo::app::parameter_reference();
           return tribo::exit_ok;
         }
-      if (args[0] == "study")
+      if (args[0] == "study" || args[0] == "tradeoff")
         {
           tribo::app::StudyOptions s;
+          s.require_tradeoff = args[0] == "tradeoff";
           for (std::size_t i = 1; i < args.size(); ++i)
             {
               if (args[i] == "--output" && i + 1 < args.size())
@@ -69,14 +73,14 @@ int main(int argc, char **argv)
               else if (args[i] == "--quiet")
                 s.quiet = true;
               else if (!args[i].empty() && args[i][0] == '-')
-                usage_error("unknown option '" + args[i] + "' for 'tribo study'");
+                usage_error("unknown option '" + args[i] + "' for 'tribo " + args[0] + "'");
               else if (s.study_file.empty())
                 s.study_file = args[i];
               else
                 usage_error("more than one study file");
             }
           if (s.study_file.empty())
-            usage_error("'tribo study' needs a study file");
+            usage_error("'tribo " + args[0] + "' needs a study file");
           dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
           return tribo::app::run_study(s);
         }

@@ -11,6 +11,7 @@
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -72,6 +73,18 @@ namespace tribo::app
       return os.str();
     }
 
+    /// @p v as one CSV field: quoted (with doubled quotes, newlines as blanks) if it holds
+    /// a comma, a quote or a newline.
+    std::string csv_field(const std::string &v)
+    {
+      if (v.find_first_of(",\"\n") == std::string::npos)
+        return v;
+      std::string q;
+      for (const char ch : v)
+        q += (ch == '"' ? std::string("\"\"") : std::string(1, ch == '\n' ? ' ' : ch));
+      return "\"" + q + "\"";
+    }
+
     /// A value of summary.json "results" (or the top level), or "" if absent/null.
     std::string value_of(const boost::property_tree::ptree &tree, const std::string &key)
     {
@@ -93,6 +106,13 @@ namespace tribo::app
                       "Varied entries: \"Subsection/Entry = v1, v2, ...; Subsection/Entry = ...\".");
     prm.declare_entry("Fixed", "", dealii::Patterns::Anything(),
                       "Overrides for every case: \"Subsection/Entry = value; ...\".");
+    prm.declare_entry("Design", "combinations", dealii::Patterns::Selection("combinations|tradeoff"),
+                      "'combinations': every combination of the Parameters lists; 'tradeoff': the "
+                      "Reference case, then each Parameters list as a ladder varied alone from the base "
+                      "case, with cost and error against the Reference (scripts/tradeoff.py).");
+    prm.declare_entry("Reference", "", dealii::Patterns::Anything(),
+                      "Design = tradeoff: the finest setting, \"Subsection/Entry = value; ...\" (each "
+                      "entry one of the Parameters).");
     prm.leave_subsection();
     ParameterFile file(prm);
     file.parse(o.study_file);
@@ -107,21 +127,71 @@ namespace tribo::app
       if (f.values.size() != 1)
         throw InputError(file.where("Study/Fixed") + ": '" + f.path + "' has several values: vary it in Parameters");
 
-    // The combinations, as --set overrides (last axis fastest).
-    std::vector<std::vector<std::string>> cases = {{}};
+    const bool tradeoff = file.get("Study/Design") == "tradeoff";
+    if (o.require_tradeoff && !tradeoff)
+      throw InputError(file.where("Study/Design") + ": entry 'Study/Design' = '" + file.get("Study/Design") +
+                       "': expected 'tradeoff' for `tribo tradeoff` (or run the file with `tribo study`)");
+    const auto reference = parse_axes(file.get("Study/Reference"), file.where("Study/Reference"));
+
+    // The cases, as --set overrides, and what the table shows of each (its columns).
+    std::vector<std::vector<std::string>> cases, columns;
+    std::vector<std::string>              headers;
+    std::vector<std::string>              common;
     for (const auto &f : fixed)
-      cases[0].push_back(f.path + "=" + f.values[0]);
-    for (const auto &a : axes)
+      common.push_back(f.path + "=" + f.values[0]);
+    if (!tradeoff)
       {
-        std::vector<std::vector<std::string>> next;
-        for (const auto &c : cases)
+        // Every combination, last axis fastest.
+        cases   = {common};
+        columns = {{}};
+        for (const auto &a : axes)
+          {
+            headers.push_back(a.path);
+            std::vector<std::vector<std::string>> next, next_columns;
+            for (std::size_t c = 0; c < cases.size(); ++c)
+              for (const auto &v : a.values)
+                {
+                  next.push_back(cases[c]);
+                  next.back().push_back(a.path + "=" + v);
+                  next_columns.push_back(columns[c]);
+                  next_columns.back().push_back(v);
+                }
+            cases   = next;
+            columns = next_columns;
+          }
+      }
+    else
+      {
+        // The reference first, then each ladder alone (a rung equal to the reference is
+        // not run twice).
+        if (reference.empty() || axes.empty())
+          throw InputError(file.where("Study/Reference") + ": a tradeoff needs Parameters (the ladders) and "
+                           "Reference (the finest setting of each)");
+        std::string reference_text;
+        cases = {common};
+        for (const auto &r : reference)
+          {
+            if (r.values.size() != 1)
+              throw InputError(file.where("Study/Reference") + ": '" + r.path + "' has several values: the "
+                               "reference is one setting");
+            if (std::none_of(axes.begin(), axes.end(), [&](const Axis &a) { return a.path == r.path; }))
+              throw InputError(file.where("Study/Reference") + ": '" + r.path + "' is not one of the "
+                               "Parameters (the ladders)");
+            cases[0].push_back(r.path + "=" + r.values[0]);
+            reference_text += (reference_text.empty() ? "" : "; ") + r.path + " = " + r.values[0];
+          }
+        headers = {"knob", "value"};
+        columns = {{"reference", reference_text}};
+        for (const auto &a : axes)
           for (const auto &v : a.values)
             {
-              auto d = c;
-              d.push_back(a.path + "=" + v);
-              next.push_back(d);
+              auto c = common;
+              c.push_back(a.path + "=" + v);
+              if (c == cases[0])
+                continue;
+              cases.push_back(c);
+              columns.push_back({a.path, v});
             }
-        cases = next;
       }
 
     // Check every combination before running any (bad input fails fast, exit 2).
@@ -212,10 +282,10 @@ namespace tribo::app
     std::ostringstream csv, md;
     csv << "case";
     md << "| case";
-    for (const auto &a : axes)
+    for (const auto &h : headers)
       {
-        csv << ",\"" << a.path << "\"";
-        md << " | " << a.path;
+        csv << ",\"" << h << "\"";
+        md << " | " << h;
       }
     for (const auto &k : keys)
       {
@@ -224,7 +294,7 @@ namespace tribo::app
       }
     csv << ",directory\n";
     md << " |\n|---";
-    for (std::size_t c = 0; c < axes.size() + keys.size(); ++c)
+    for (std::size_t c = 0; c < headers.size() + keys.size(); ++c)
       md << "|---";
     md << "|\n";
     unsigned int n_failed = 0;
@@ -243,26 +313,16 @@ namespace tribo::app
           ++n_failed;
         csv << i;
         md << "| " << i;
-        const std::size_t n_fixed = fixed.size();
-        for (std::size_t a = 0; a < axes.size(); ++a)
+        for (const std::string &value : columns[i])
           {
-            const std::string &assignment = cases[i][n_fixed + a];
-            const std::string  value      = assignment.substr(assignment.find('=') + 1);
-            csv << "," << value;
+            csv << "," << csv_field(value);
             md << " | " << value;
           }
         for (const auto &k : keys)
           {
-            std::string v = value_of(tree, k);
+            const std::string v = value_of(tree, k);
             md << " | " << v;
-            if (v.find_first_of(",\"\n") != std::string::npos)
-              {
-                std::string q;
-                for (const char ch : v)
-                  q += (ch == '"' ? std::string("\"\"") : std::string(1, ch == '\n' ? ' ' : ch));
-                v = "\"" + q + "\"";
-              }
-            csv << "," << v;
+            csv << "," << csv_field(v);
           }
         csv << "," << case_dir(i).filename().string() << "\n";
         md << " |\n";
@@ -276,6 +336,18 @@ namespace tribo::app
                                 shell_quote((dir / "plots.log").string()) + " 2>&1";
     if (std::system(command.c_str()) != 0 && !o.quiet)
       std::cout << "warning: the study plots could not be made, see " << (dir / "plots.log").string() << std::endl;
+    if (tradeoff)
+      {
+        // Cost and error against the reference: tradeoff.csv, .md and .png. A failure here
+        // is an error: the table is what a tradeoff is for.
+        const std::string t = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR + "/scripts/tradeoff.py " +
+                              shell_quote(dir.string()) + " > " + shell_quote((dir / "tradeoff.log").string()) +
+                              " 2>&1";
+        if (std::system(t.c_str()) != 0)
+          throw RunError("the tradeoff table could not be made, see " + (dir / "tradeoff.log").string());
+        if (!o.quiet)
+          std::cout << "tradeoff: " << (dir / "tradeoff.md").string() << std::endl;
+      }
     if (!o.quiet)
       std::cout << "study: " << cases.size() << " cases, " << n_failed << " not complete; table "
                 << (dir / "study_summary.csv").string() << std::endl;

@@ -17,6 +17,13 @@
 /// study interrupted at any point resumes where it stopped and never mixes results
 /// of different parameter sets. A failed case is a row with its status and error;
 /// the others go on. OUTPUT/study_summary.csv and .md hold one row per case.
+///
+/// With `set Design = tradeoff` the Parameters lists are ladders of the knobs that cost
+/// time (time step, tolerance, mesh, model, ...): case 0 is the Reference (the finest
+/// setting, `set Reference = Solver/Tolerance = 1e-5; ...`), then each ladder is run
+/// alone from the base case. scripts/tradeoff.py then writes tradeoff.csv, tradeoff.md
+/// and tradeoff.png: the cost (wall time per simulated time) and the error against the
+/// reference in what users read (docs/tradeoff.md).
 
 #include <string>
 
@@ -27,6 +34,8 @@ namespace tribo::app
     std::string study_file;
     std::string output_dir; ///< empty: output/<study file stem>
     bool        quiet = false;
+    /// `tribo tradeoff`: the file must have Design = tradeoff.
+    bool        require_tradeoff = false;
   };
 
   /// Run a study; returns the exit code (0 even if some cases failed: see the table).

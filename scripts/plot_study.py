@@ -53,7 +53,7 @@ def main(directory):
         axes[1].set_xlabel("sigma_yy (MPa)")
         axes[2].set_xlabel("sigma_xy (MPa)")
         axes[0].set_ylabel("y / h")
-        axes[2].legend(fontsize=7)
+        axes[2].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1))
         save(fig, os.path.join(directory, "profiles_overlay.png"))
     else:
         plt.close(fig)

@@ -2,6 +2,9 @@
 """`tribo study`: two cases over two MPI ranks give the same summary rows as one after
 another; an interrupted study resumes without redoing finished cases; changed fixed
 parameters never mix with old results; bad study input fails before anything runs.
+`tribo tradeoff` (Design = tradeoff): the reference and each ladder's rungs are run,
+and tradeoff.csv holds the cost and the errors against the reference, recomputed here
+from each case's own outputs.
 
 Usage: test_study.py PATH/TO/tribo
 """
@@ -13,6 +16,8 @@ import subprocess
 import sys
 import tempfile
 import unittest
+
+import numpy as np
 
 TRIBO = None
 
@@ -44,6 +49,15 @@ subsection Study
   set Base case = base.prm
   set Parameters = Contact law/Cohesion = 0, 120
   set Fixed = Contact law/Cohesion range = 2.4e-8{extra}
+end
+"""
+
+TRADEOFF = """
+subsection Study
+  set Base case = base.prm
+  set Design = tradeoff
+  set Parameters = Solver/Tolerance = 1e-2, 1e-3; Simulation/Time step = 4e-9
+  set Reference = {reference}
 end
 """
 
@@ -142,6 +156,80 @@ class Study(unittest.TestCase):
                            capture_output=True, text=True, timeout=60)
         self.assertEqual(p.returncode, 2)
         self.assertIn("entry 'Contact law/Cohesion' = '-5': expected a cohesion >= 0 in N/m", p.stderr)
+        self.assertFalse(os.path.exists(out))
+
+
+class Tradeoff(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+        with open(os.path.join(self.dir, "base.prm"), "w") as f:
+            f.write(BASE)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def tradeoff(self, reference, command="tradeoff", design="tradeoff"):
+        path = os.path.join(self.dir, "tradeoff.prm")
+        with open(path, "w") as f:
+            f.write(TRADEOFF.format(reference=reference).replace("Design = tradeoff", "Design = " + design))
+        out = os.path.join(self.dir, "out")
+        p = subprocess.run([TRIBO, command, path, "--output", out, "--quiet"], capture_output=True, text=True,
+                           timeout=600)
+        return p, path, out
+
+    def test_cost_and_errors_against_the_reference(self):
+        p, _, out = self.tradeoff("Solver/Tolerance = 1e-4; Simulation/Time step = 2e-9")
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        with open(os.path.join(out, "tradeoff.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([(r["knob"], r["value"]) for r in rows],
+                         [("reference", "Solver/Tolerance = 1e-4; Simulation/Time step = 2e-9"),
+                          ("Solver/Tolerance", "1e-2"), ("Solver/Tolerance", "1e-3"),
+                          ("Simulation/Time step", "4e-9")])
+        self.assertEqual([r["status"] for r in rows], ["complete"] * 4)
+
+        def outputs(r):
+            d = os.path.join(out, r["directory"])
+            with open(os.path.join(d, "summary.json")) as f:
+                s = json.load(f)
+            return s, np.genfromtxt(os.path.join(d, "profiles.csv"), delimiter=",", names=True)
+
+        ref_summary, ref_profiles = outputs(rows[0])
+        mu_ref = ref_summary["results"]["mu_mean"]
+        self.assertEqual(float(rows[0]["cost_ratio"]), 1.0)
+        for q in ("mu_error", "vx_l2", "sigma_yy_l2", "sigma_xy_l2"):
+            self.assertEqual(float(rows[0][q]), 0.0, q)
+        for r in rows:
+            s, prof = outputs(r)
+            self.assertAlmostEqual(float(r["cost"]), s["wall_time"] / (s["simulated_time"] * 1e6),
+                                   delta=1e-9 * float(r["cost"]))
+            self.assertAlmostEqual(float(r["mu_error"]), abs(s["results"]["mu_mean"] - mu_ref) / abs(mu_ref),
+                                   delta=1e-12)
+            self.assertAlmostEqual(float(r["balance_residual"]), abs(1 - s["results"]["power_balance_ratio"]),
+                                   delta=1e-12)
+            syy = np.interp(ref_profiles["y_over_h"], prof["y_over_h"], prof["sigma_yy"])
+            self.assertAlmostEqual(float(r["sigma_yy_l2"]),
+                                   np.linalg.norm(syy - ref_profiles["sigma_yy"]) /
+                                   np.linalg.norm(ref_profiles["sigma_yy"]), delta=1e-12)
+        # A looser tolerance buys its speed with fewer sweeps.
+        self.assertLess(float(rows[1]["nlgs_sweeps_per_step"]), float(rows[0]["nlgs_sweeps_per_step"]))
+        # The time-step rung really ran at its step (half the steps of the reference).
+        self.assertEqual(outputs(rows[3])[0]["steps"] * 2, ref_summary["steps"])
+        with open(os.path.join(out, "tradeoff.md")) as f:
+            self.assertIn("its standard error (batch means)", f.read())
+        self.assertGreater(os.path.getsize(os.path.join(out, "tradeoff.png")), 10000)
+
+    def test_bad_tradeoff_input_fails_before_running(self):
+        p, path, out = self.tradeoff("Contact law/Cohesion = 60")
+        self.assertEqual(p.returncode, 2)
+        self.assertEqual(p.stderr.strip(), "error: %s:6: 'Contact law/Cohesion' is not one of the "
+                         "Parameters (the ladders)" % path)
+        self.assertFalse(os.path.exists(out))
+        p, path, out = self.tradeoff("Solver/Tolerance = 1e-4", design="combinations")
+        self.assertEqual(p.returncode, 2)
+        self.assertEqual(p.stderr.strip(), "error: %s:4: entry 'Study/Design' = 'combinations': expected "
+                         "'tradeoff' for `tribo tradeoff` (or run the file with `tribo study`)" % path)
         self.assertFalse(os.path.exists(out))
 
 

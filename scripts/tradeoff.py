@@ -1,0 +1,188 @@
+#!/usr/bin/python3
+"""Cost against error of a tradeoff study (Study/Design = tradeoff; docs/tradeoff.md).
+
+    /usr/bin/python3 scripts/tradeoff.py STUDY_OUTPUT_DIR
+
+Reads study_summary.csv (case 0 is the reference, each other row one rung of one
+ladder, columns "knob" and "value") and each case's summary.json, statistics.csv and
+profiles.csv. For every complete case:
+
+- cost: wall time per simulated time, s per simulated microsecond (summary.json
+  wall_time / simulated_time), and its ratio to the reference's;
+- mu_error: |mu - mu_ref| / mu_ref over the steady state;
+- vx_l2, sigma_yy_l2, sigma_xy_l2: relative L2 differences of the profiles,
+  ||p - p_ref|| / ||p_ref||, with p interpolated at the reference's layer heights y/h;
+- balance_residual: |1 - P_dissipated / P_lower_wall| of the case itself;
+- mu_scatter: the reference's standard error of mean mu by batch means (20 batches
+  over the steady-state rows of statistics.csv): differences below about twice it are
+  noise, not error.
+
+Writes tradeoff.csv, tradeoff.md and tradeoff.png (cost against the mu error and
+against the largest profile error, Pareto fronts drawn); exits 1 if the reference is
+not complete.
+"""
+import csv
+import json
+import math
+import os
+import sys
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+PROFILES = ("vx", "sigma_yy", "sigma_xy")
+
+
+def read_profiles(path):
+    if not os.path.exists(path) or os.path.getsize(path) == 0:
+        return None
+    p = np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True))
+    return p if p.size >= 2 else None
+
+
+def relative_l2(p, ref, q):
+    """||p_q - ref_q|| / ||ref_q|| with p interpolated at ref's y/h."""
+    values = np.interp(ref["y_over_h"], p["y_over_h"], p[q])
+    norm = np.linalg.norm(ref[q])
+    return float(np.linalg.norm(values - ref[q]) / norm) if norm > 0 else float("nan")
+
+
+def batch_standard_error(stats_path, t_start, batches=20):
+    """Standard error of the mean of mu over t >= t_start, by batch means."""
+    with open(stats_path) as f:
+        mu = np.array([float(r["mu"]) for r in csv.DictReader(f) if float(r["time"]) >= t_start])
+    if mu.size < 2 * batches:
+        return float("nan")
+    means = np.array([b.mean() for b in np.array_split(mu, batches)])
+    return float(means.std(ddof=1) / math.sqrt(batches))
+
+
+def pareto(points):
+    """Indices of the points (cost, error) that no other point beats in both."""
+    front = []
+    for i, (c, e) in enumerate(points):
+        if not (math.isfinite(c) and math.isfinite(e)):
+            continue
+        if not any((c2 <= c and e2 <= e) and (c2 < c or e2 < e)
+                   for j, (c2, e2) in enumerate(points) if j != i and math.isfinite(c2) and math.isfinite(e2)):
+            front.append(i)
+    return sorted(front, key=lambda i: points[i][0])
+
+
+def fmt(v, digits=3):
+    return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{digits}g}"
+
+
+def main(directory):
+    with open(os.path.join(directory, "study_summary.csv")) as f:
+        rows = list(csv.DictReader(f))
+    if not rows or "knob" not in rows[0]:
+        sys.exit(f"{directory}/study_summary.csv: not a tradeoff study (no 'knob' column)")
+    cases = []
+    for r in rows:
+        d = os.path.join(directory, r["directory"])
+        try:
+            with open(os.path.join(d, "summary.json")) as f:
+                s = json.load(f)
+        except (OSError, ValueError):
+            s = {"status": "missing"}
+        cases.append({"row": r, "dir": d, "summary": s, "complete": s.get("status") == "complete"})
+    ref = cases[0]
+    if not ref["complete"]:
+        sys.exit(f"{directory}: the reference case ({ref['row']['directory']}) is not complete: "
+                 f"status {ref['summary'].get('status')}")
+    ref_results = ref["summary"]["results"]
+    ref_profiles = read_profiles(os.path.join(ref["dir"], "profiles.csv"))
+    mu_ref = ref_results.get("mu_mean")
+    scatter = batch_standard_error(os.path.join(ref["dir"], "statistics.csv"),
+                                   ref_results.get("steady_state_start") or 0.0)
+
+    table = []
+    for c in cases:
+        s = c["summary"]
+        out = {"knob": c["row"]["knob"], "value": c["row"]["value"], "status": s.get("status", "missing"),
+               "directory": c["row"]["directory"]}
+        if c["complete"]:
+            res = s["results"]
+            out["cost"] = s["wall_time"] / (s["simulated_time"] * 1e6)
+            mu = res.get("mu_mean")
+            out["mu_mean"] = mu
+            out["mu_error"] = abs(mu - mu_ref) / abs(mu_ref) if mu is not None and mu_ref else float("nan")
+            prof = read_profiles(os.path.join(c["dir"], "profiles.csv"))
+            for q in PROFILES:
+                out[q + "_l2"] = (relative_l2(prof, ref_profiles, q)
+                                  if prof is not None and ref_profiles is not None else float("nan"))
+            ratio = res.get("power_balance_ratio")
+            out["balance_residual"] = abs(1 - ratio) if ratio is not None else float("nan")
+            out["nlgs_sweeps_per_step"] = s.get("nlgs_iterations_mean")
+            out["steady_state_reached"] = res.get("steady_state_reached")
+        table.append(out)
+    ref_cost = table[0]["cost"]
+    for t in table:
+        if "cost" in t:
+            t["cost_ratio"] = t["cost"] / ref_cost
+
+    columns = ["knob", "value", "status", "cost", "cost_ratio", "mu_mean", "mu_error", "vx_l2",
+               "sigma_yy_l2", "sigma_xy_l2", "balance_residual", "nlgs_sweeps_per_step",
+               "steady_state_reached", "directory"]
+    tmp = os.path.join(directory, "tradeoff.csv.tmp")
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+        w.writeheader()
+        for t in table:
+            w.writerow({k: t.get(k, "") for k in columns})
+    os.replace(tmp, os.path.join(directory, "tradeoff.csv"))
+
+    md = [f"Reference: {table[0]['value']}; mean mu {fmt(mu_ref, 4)}, its standard error "
+          f"(batch means) {fmt(scatter, 2)}: mu errors below about {fmt(2 * scatter / mu_ref if mu_ref else float('nan'), 2)} "
+          "are within the noise.", "",
+          "| knob | value | cost (s per simulated us) | cost / reference | mean mu | mu error | vx L2 | "
+          "sigma_yy L2 | sigma_xy L2 | balance residual | sweeps/step | status |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for t in table:
+        md.append("| " + " | ".join([t["knob"], t["value"], fmt(t.get("cost")), fmt(t.get("cost_ratio")),
+                                     fmt(t.get("mu_mean"), 4), fmt(t.get("mu_error"), 2), fmt(t.get("vx_l2"), 2),
+                                     fmt(t.get("sigma_yy_l2"), 2), fmt(t.get("sigma_xy_l2"), 2),
+                                     fmt(t.get("balance_residual"), 2), fmt(t.get("nlgs_sweeps_per_step"), 4),
+                                     t["status"]]) + " |")
+    with open(os.path.join(directory, "tradeoff.md.tmp"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    os.replace(os.path.join(directory, "tradeoff.md.tmp"), os.path.join(directory, "tradeoff.md"))
+
+    done = [t for t in table if "cost" in t]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    knobs = sorted({t["knob"] for t in done if t["knob"] != "reference"})
+    colours = {k: f"C{i}" for i, k in enumerate(knobs)}
+    rungs = [t for t in done if t["knob"] != "reference"]
+    for ax, key, label in ((axes[0], "mu_error", "|mu - mu_ref| / mu_ref"),
+                           (axes[1], None, "largest profile L2 error (vx, sigma_yy, sigma_xy)")):
+        err = [t[key] if key else max(t[q + "_l2"] for q in PROFILES) for t in rungs]
+        cost = [t["cost"] for t in rungs]
+        for t, c, e in zip(rungs, cost, err):
+            ax.plot(c, e, "o", color=colours[t["knob"]])
+            ax.annotate(t["value"], (c, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
+        front = pareto(list(zip(cost, err)))
+        ax.plot([cost[i] for i in front], [err[i] for i in front], "k--", lw=1, label="Pareto front")
+        ax.axvline(ref_cost, color="k", lw=1, label="reference cost (its error is 0)")
+        if key == "mu_error" and math.isfinite(scatter) and mu_ref:
+            ax.axhline(2 * scatter / mu_ref, color="grey", lw=0.8, ls=":", label="2 x standard error of mu_ref")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("cost: wall s per simulated us")
+        ax.set_ylabel(label)
+    for k in knobs:
+        axes[0].plot([], [], "o", color=colours[k], label=k)
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    tmp = os.path.join(directory, "tradeoff.tmp.png")
+    fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    os.replace(tmp, os.path.join(directory, "tradeoff.png"))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
