@@ -72,6 +72,42 @@ namespace tribo::app
       for (const std::string &file : scene.write_fields(writer.directory(), writer.n_snapshots() - 1))
         writer.index(file.substr(0, file.rfind('_')), t, file);
     }
+
+    /// Where the steps' wall time goes, over the steps of this process (since the start
+    /// or the last resumption: not checkpointed), for summary.json "timing".
+    struct StepTiming
+    {
+      unsigned long steps = 0, sweeps = 0;
+      double        step = 0, detection = 0, boundary_body = 0, solver = 0;
+      double        contact_updates = 0; ///< sum over steps of sweeps x contacts
+
+      void add(const dem::StepReport &r)
+      {
+        ++steps;
+        sweeps += r.solver.iterations;
+        step += r.time_step;
+        detection += r.time_detection;
+        boundary_body += r.time_boundary_body;
+        solver += r.time_solver;
+        contact_updates += double(r.solver.iterations) * r.n_contacts;
+      }
+
+      /// Means per step, s, and the NLGS cost per contact update, ns.
+      JsonObject to_json() const
+      {
+        JsonObject j;
+        const double n = std::max(1ul, steps);
+        j.set("steps", long(steps));
+        j.set("step_mean_s", step / n);
+        j.set("detection_mean_s", detection / n);
+        j.set("boundary_body_mean_s", boundary_body / n);
+        j.set("nlgs_mean_s", solver / n);
+        j.set("other_mean_s", (step - detection - boundary_body - solver) / n);
+        j.set("nlgs_sweeps_mean", double(sweeps) / n);
+        j.set("nlgs_ns_per_contact_update", contact_updates > 0 ? 1e9 * solver / contact_updates : 0.0);
+        return j;
+      }
+    };
   } // namespace
 
   bool may_change_on_resume(const std::string &entry)
@@ -285,6 +321,7 @@ namespace tribo::app
     unsigned long step = 0, total_iterations = 0, non_converged = 0, max_iterations = 0;
     double        worst_overlap = 0, t = 0, max_residual = 0;
     double        wall_before = 0; ///< wall time of the run before its last resumption, s
+    StepTiming    timing;          ///< the steps since the start or the last resumption
 
     // A checkpoint holds the resolved parameters, the loop's counters and every object's
     // state, in this order (core/checkpoint.h).
@@ -340,6 +377,7 @@ namespace tribo::app
             ++step;
             t = step * h;
             total_iterations += r.solver.iterations;
+            timing.add(r);
             max_iterations = std::max<unsigned long>(max_iterations, r.solver.iterations);
             max_residual   = std::max(max_residual, r.solver.residual);
             worst_overlap  = std::max(worst_overlap, r.max_overlap);
@@ -421,6 +459,7 @@ namespace tribo::app
     summary.set("n_bodies", long(system.bodies.size()));
     summary.set("n_discs", long(system.discs.size()));
     summary.set("n_field_snapshots", long(fields.n_snapshots()));
+    summary.set("timing", timing.to_json());
     JsonObject scene_results;
     if (!stats.rows().empty())
       scene->summarize(system, stats, scene_results);
@@ -452,6 +491,13 @@ namespace tribo::app
     os << "status " << status << ": " << step << " steps in " << wall << " s, "
        << (step ? double(total_iterations) / step : 0.0) << " NLGS sweeps per step, "
        << non_converged << " steps not converged, worst overlap " << worst_overlap << " m";
+    if (timing.steps > 0)
+      {
+        const double n = timing.steps;
+        os << "; per step " << 1e3 * timing.step / n << " ms: NLGS " << 1e3 * timing.solver / n
+           << " ms, detection " << 1e3 * timing.detection / n << " ms, upper body "
+           << 1e3 * timing.boundary_body / n << " ms";
+      }
     log(os.str());
     return finish_run(log, status, failure);
   }

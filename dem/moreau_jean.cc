@@ -7,6 +7,7 @@
 #include <boost/serialization/string.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -28,8 +29,18 @@ namespace tribo::dem
     half_discs = std::make_unique<HalfDiscs>(body, half_disc_diameter, outward, period);
   }
 
+  namespace
+  {
+    /// Seconds since @p start.
+    double seconds_since(const std::chrono::steady_clock::time_point &start)
+    {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+  } // namespace
+
   StepReport MoreauJean::step(ParticleSystem &system, double h)
   {
+    const auto        step_start = std::chrono::steady_clock::now();
     StepReport        report;
     const std::size_t nb = system.bodies.size();
 
@@ -61,14 +72,18 @@ namespace tribo::dem
         const Disc &disc = system.discs[d];
         centres[d] = system.wrap(x_pred[disc.body] + rotate(disc.offset, angle_pred[disc.body]));
       }
+    auto                 phase = std::chrono::steady_clock::now();
     std::vector<Contact> found = detector.detect(system, centres, distance);
+    report.time_detection      = seconds_since(phase);
 
     // The boundary body: free state, predicted nodes, half-disc contacts.
     std::vector<Vec2> node_v_begin;
     if (boundary)
       {
         const unsigned int nn = boundary->n_nodes();
+        phase                 = std::chrono::steady_clock::now();
         boundary->predict(h);
+        report.time_boundary_body = seconds_since(phase);
         std::vector<Vec2> nodes(nn);
         node_v_begin.resize(nn);
         state.node_velocity.resize(2 * nn);
@@ -79,7 +94,9 @@ namespace tribo::dem
             state.node_velocity.segment<2>(2 * i) = boundary->node_free_velocity(i);
           }
         state.node_compliance = &boundary->compliance();
+        phase            = std::chrono::steady_clock::now();
         auto on_boundary = half_discs->detect(system, centres, angle_pred, nodes, distance);
+        report.time_detection += seconds_since(phase);
         report.n_boundary_contacts = on_boundary.size();
         found.insert(found.end(), on_boundary.begin(), on_boundary.end());
       }
@@ -120,7 +137,9 @@ namespace tribo::dem
       if (c.r.x() != 0 || c.r.y() != 0)
         state.apply_impulse(c, c.r);
 
-    report.solver = solver.solve(current, state, contact_law, th * h);
+    phase              = std::chrono::steady_clock::now();
+    report.solver      = solver.solve(current, state, contact_law, th * h);
+    report.time_solver = seconds_since(phase);
 
     // Gap measures with the final velocities.
     previous_impulse.clear();
@@ -204,7 +223,9 @@ namespace tribo::dem
         const unsigned int nn = boundary->n_nodes();
         if (!state.node_velocity.allFinite())
           throw RunError("the boundary body's nodes have non-finite velocities: the solver diverged");
+        phase = std::chrono::steady_clock::now();
         boundary->finalize(node_impulse);
+        report.time_boundary_body += seconds_since(phase);
         // With the body's own end velocities (not the solver's running copy, which
         // carries the round-off of many incremental updates), the balance is exact.
         for (unsigned int i = 0; i < nn; ++i)
@@ -218,8 +239,10 @@ namespace tribo::dem
         report.boundary_dissipation = boundary->internal_dissipation();
       }
     report.kinetic_energy = system.kinetic_energy();
+    report.time_step      = seconds_since(step_start);
     return report;
   }
+
   void MoreauJean::save(CheckpointOut &ar) const
   {
     // Sorted by key: the file does not depend on the hash table's layout.

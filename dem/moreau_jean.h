@@ -47,6 +47,11 @@ namespace tribo::dem
     double boundary_energy      = 0;
     double boundary_dissipation = 0;
     unsigned int n_boundary_contacts = 0; ///< contacts with half-disc elements
+    /// Wall time of the step and of its phases, s: detection (disc pairs and half-discs),
+    /// the boundary body's own work (its free state in predict() and its update in
+    /// finalize()), and the NLGS solve; the rest is setting up the local problems and
+    /// the update of the discs.
+    double time_step = 0, time_detection = 0, time_boundary_body = 0, time_solver = 0;
   };
 
   /// The integrator; it owns the contacts of the current step.
