@@ -168,10 +168,12 @@ namespace tribo::app
                       "0: the cell size (one per boundary edge, the paper's choice).");
     prm.declare_entry("Upper body compaction damping", "1", Double(),
                       "Damping ratio zeta (>= 0) of the deformable upper body's first thickness mode, "
-                      "omega_1 = pi c_p / (2 H), added before Shear start as stiffness-proportional "
-                      "damping b_c = 2 zeta / omega_1 and removed when shearing starts: the body lands "
-                      "on the layer at about 1 m/s and would otherwise ring (no numerical damping at "
-                      "theta = 0.5). The rigid wall's Compaction speed limit plays this part. 0: off.");
+                      "omega_1 = pi c_p / (2 H), added before Shear start as damping of the velocity "
+                      "towards rest at gamma = 2 zeta omega_1 (fem: mass-proportional Rayleigh damping) "
+                      "and removed when shearing starts: the body then lands on the layer at the "
+                      "terminal speed P / (rho H gamma) (0.7 m/s for the paper's steel body) instead of "
+                      "falling freely onto it, and does not ring (no numerical damping at theta = 0.5). "
+                      "The rigid wall's Compaction speed limit plays this part. 0: off.");
     prm.leave_subsection();
   }
 

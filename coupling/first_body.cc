@@ -104,9 +104,10 @@ namespace tribo::coupling
       e.top_pressure       = p.pressure;
       e.pressure_ramp_time = p.pressure_ramp_time;
       e.top_fixed_in_x     = true;
-      // Until shearing starts: b + 2 zeta / omega_1, omega_1 = pi c_p / (2 H).
+      // Until shearing starts: a + 2 zeta omega_1, omega_1 = pi c_p / (2 H): damping towards
+      // rest, as for the particle bodies, which also caps the compaction stroke.
       if (p.compaction_damping > 0)
-        e.rayleigh_stiffness += 2 * p.compaction_damping / (M_PI * p_wave_speed(p) / (2 * e.thickness));
+        e.rayleigh_mass += 2 * p.compaction_damping * M_PI * p_wave_speed(p) / (2 * e.thickness);
       return std::make_unique<ElasticBoundary>(std::make_unique<fem::ElasticBody>(e), p.rayleigh_mass,
                                                p.rayleigh_stiffness);
     }

@@ -13,7 +13,8 @@
 ///
 /// All share: period L along x, thickness H, bottom face (the chain) at y0, top face
 /// held in x and loaded by the pressure P(t) = P min(1, t / ramp) (compressive), and a
-/// compaction damping of ratio zeta on the first thickness mode until start_shearing().
+/// compaction damping (towards rest, ratio zeta on the first thickness mode) until
+/// start_shearing().
 /// Units per unit depth: m, kg/m, N/m, J/m, W/m.
 
 #include "core/checkpoint.h"
@@ -45,12 +46,12 @@ namespace tribo::coupling
     double       pressure = 0;           ///< P, Pa (> 0: compressive)
     double       pressure_ramp_time = 0; ///< s; 0: a step at t = 0
     /// Damping ratio zeta of the first thickness mode, omega_1 = pi c_p / (2 H), until
-    /// start_shearing() (0: none). fem: stiffness-proportional b_c = 2 zeta / omega_1;
-    /// particles: damping of every particle's velocity towards rest at
-    /// gamma = 2 zeta omega_1 (1/s), which also caps the compaction stroke at the
-    /// terminal speed P / (rho H gamma) (0.9 m/s for the paper's steel body at zeta = 1,
-    /// as the rigid wall's Compaction speed limit does; an explicit particle chain hit
-    /// at tens of m/s lets grains through).
+    /// start_shearing() (0: none), in every model as damping of the velocity towards rest
+    /// at gamma = 2 zeta omega_1 (1/s; fem: mass-proportional Rayleigh a_c = gamma),
+    /// which also caps the compaction stroke at the terminal speed P / (rho H gamma)
+    /// (0.7 m/s for the paper's steel body at zeta = 1, as the rigid wall's Compaction
+    /// speed limit does; a body that falls freely onto the layer hits it at tens of m/s,
+    /// 47 m/s for the paper's sample, and drives grains through its surface).
     double       compaction_damping = 0;
     /// Smoothing length over spacing (sph).
     double       smoothing_ratio = 1.2;
