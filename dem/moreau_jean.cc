@@ -143,11 +143,14 @@ namespace tribo::dem
 
     // Gap measures with the final velocities.
     previous_impulse.clear();
-    double eps_sum = 0, min_gap_end = 0;
+    double eps_sum = 0, min_gap_end = 0, min_gap_any = 0;
     for (const Contact &c : current)
       {
         if (c.r.x() == 0 && c.r.y() == 0)
-          continue;
+          {
+            min_gap_any = std::min(min_gap_any, c.gap + th * h * state.local_velocity(c).x());
+            continue;
+          }
         previous_impulse[c.key()] = c.r;
         ++report.n_active;
         const double un = state.local_velocity(c).x();
@@ -156,6 +159,7 @@ namespace tribo::dem
       }
     report.epsilon     = report.n_active ? eps_sum / report.n_active : 0;
     report.max_overlap = std::max(0.0, -min_gap_end);
+    const double deepest_overlap = std::max(report.max_overlap, -min_gap_any); // any contact
 
     // Contact force on every body over the step.
     body_force.assign(nb, Eigen::Vector3d::Zero());
@@ -178,6 +182,7 @@ namespace tribo::dem
 
     // Update, powers and guards.
     body_power.assign(nb, 0.0);
+    std::pair<double, std::size_t> fastest{0.0, 0}; // speed (m/s) and body
     for (std::size_t b = 0; b < nb; ++b)
       {
         RigidBody &body = system.bodies[b];
@@ -207,6 +212,7 @@ namespace tribo::dem
               report.power_free += (body_force[b][k] + (body.drive[k] == Drive::force ? body.load[k] : 0)) * v_mid[k];
           }
         report.power_external += body_power[b];
+        fastest = std::max(fastest, {v.head<2>().norm(), b});
         body.velocity = v.head<2>();
         body.spin     = v.z();
         body.position = x_pred[b] + th * h * body.velocity;
@@ -237,6 +243,32 @@ namespace tribo::dem
         report.power_external += boundary->external_power();
         report.boundary_energy      = boundary->energy();
         report.boundary_dissipation = boundary->internal_dissipation();
+      }
+    // Two discs overlapping by more than the smallest radius have passed through each
+    // other: contacts were missed (something moved too far in one step for the detection
+    // to see it coming) or the solver left them unresolved. Stop, naming the fastest mover.
+    const double r_min = system.discs.empty() ? 0 : system.min_radius();
+    if (r_min > 0 && deepest_overlap > r_min)
+      {
+        double fastest_node = 0;
+        if (boundary)
+          for (unsigned int i = 0; i < boundary->n_nodes(); ++i)
+            fastest_node = std::max(fastest_node, boundary->node_velocity(i).norm());
+        const double speed = std::max(fastest.first, fastest_node);
+        std::ostringstream os;
+        os << "an overlap of " << deepest_overlap << " m, more than the smallest disc radius ("
+           << r_min << " m): contacts were missed or left unresolved (NLGS "
+           << (report.solver.converged ? "converged" : "not converged") << "). ";
+        if (speed * h > 0.1 * r_min)
+          os << "The fastest mover, "
+             << (fastest.first >= fastest_node ? "body " + std::to_string(fastest.second)
+                                               : std::string("a node of the deformable upper body"))
+             << ", moved " << speed * h << " m in the step (" << speed << " m/s); a step of at most "
+             << 0.25 * r_min / speed << " s keeps it within a quarter of the smallest radius";
+        else
+          os << "No body moved more than a tenth of the smallest radius in the step: the overlap "
+                "does not come from the step size (discs placed overlapping?)";
+        throw RunError(os.str());
       }
     report.kinetic_energy = system.kinetic_energy();
     report.time_step      = seconds_since(step_start);

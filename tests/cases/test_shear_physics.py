@@ -15,6 +15,7 @@ Usage: test_shear_physics.py PATH/TO/tribo
 import concurrent.futures
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -150,7 +151,7 @@ class ShearCell(unittest.TestCase):
 
 class WallThroughLayer(unittest.TestCase):
     """A step far too large with no compaction speed limit: the upper wall tunnels
-    through the layer. The run must stop as failed, naming the cause, not end
+    into the layer. The run must stop as failed, naming the cause, not end
     'complete' with nonsense (negative solid fraction)."""
 
     def test_run_stops_with_the_reason(self):
@@ -168,8 +169,15 @@ class WallThroughLayer(unittest.TestCase):
             with open(os.path.join(out, "summary.json")) as f:
                 summary = json.load(f)
             self.assertEqual(summary["status"], "failed")
-            self.assertIn("has passed through the layer", summary["error"])
-            self.assertIn("smaller Simulation/Time step", summary["error"])
+            # The first symptom stops it: grains overlapping by more than a radius, with
+            # the fastest mover and a step that keeps it within a quarter radius.
+            self.assertIn("more than the smallest disc radius", summary["error"])
+            m = re.search(r"moved ([0-9.e+-]+) m in the step \(([0-9.e+-]+) m/s\); a step of at most "
+                          r"([0-9.e+-]+) s", summary["error"])
+            self.assertIsNotNone(m, summary["error"])
+            moved, speed, step = map(float, m.groups())
+            self.assertAlmostEqual(moved, speed * 2e-7, delta=1e-5 * moved)
+            self.assertLess(step, 2e-7)
 
 
 if __name__ == "__main__":

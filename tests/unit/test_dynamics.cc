@@ -1,4 +1,5 @@
 // Moreau-Jean stepping against closed-form mechanics.
+#include "core/errors.h"
 #include "dem/moreau_jean.h"
 
 #include <gtest/gtest.h>
@@ -219,4 +220,53 @@ TEST(Dynamics, NlgsSolutionSatisfiesSignorini)
         }
     }
   EXPECT_GT(loaded, 10u);
+}
+
+TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
+{
+  // Discs placed overlapping by 0.7 um (> r = 0.6 um), at rest: IQS freezes the overlap.
+  ParticleSystem placed;
+  placed.add_disc({0, 0}, r, rho);
+  placed.add_disc({2 * r - 0.7e-6, 0}, r, rho);
+  MoreauJean mj(0.5, ContactLaw{}, tight(), 1e-8);
+  try
+    {
+      mj.step(placed, 1e-8);
+      FAIL() << "no error for an overlap deeper than a radius";
+    }
+  catch (const tribo::RunError &e)
+    {
+      EXPECT_STREQ(e.what(), "an overlap of 7e-07 m, more than the smallest disc radius (6e-07 m): "
+                             "contacts were missed or left unresolved (NLGS converged). No body moved "
+                             "more than a tenth of the smallest radius in the step: the overlap does "
+                             "not come from the step size (discs placed overlapping?)");
+    }
+  // Closing at 200 m/s from a gap of 0.1 um in steps of 1e-8 s (2 um per step): the
+  // pair is detected and stopped, but the explicit half step (1 - theta) h v carries it
+  // 1 um into the overlap.
+  ParticleSystem fast;
+  fast.add_disc({0, 0}, r, rho);
+  fast.add_disc({2 * r + 1e-7, 0}, r, rho);
+  fast.bodies[1].velocity = {-200, 0};
+  MoreauJean mj2(0.5, ContactLaw{}, tight(), 1e-6);
+  try
+    {
+      mj2.step(fast, 1e-8);
+      FAIL() << "no error for a step of 2 um";
+    }
+  catch (const tribo::RunError &e)
+    {
+      EXPECT_STREQ(e.what(), "an overlap of 9e-07 m, more than the smallest disc radius (6e-07 m): "
+                             "contacts were missed or left unresolved (NLGS converged). The fastest "
+                             "mover, body 1, moved 1e-06 m in the step (100 m/s); a step of at most "
+                             "1.5e-09 s keeps it within a quarter of the smallest radius");
+    }
+  // At 20 m/s the same pair ends the step with an overlap of at most (1 - theta) h v.
+  ParticleSystem slow;
+  slow.add_disc({0, 0}, r, rho);
+  slow.add_disc({2 * r + 1e-7, 0}, r, rho);
+  slow.bodies[1].velocity = {-20, 0};
+  MoreauJean mj3(0.5, ContactLaw{}, tight(), 1e-6);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_NO_THROW(mj3.step(slow, 1e-8));
 }
