@@ -66,6 +66,24 @@ namespace tribo::sph
   }
 
   template <int dim>
+  void Solver<dim>::update_neighbours(const ParticleState<dim> &s, double cutoff)
+  {
+    const unsigned int n = s.size();
+    double             moved2 = 0;
+    if (x_at_build.size() == n)
+      for (unsigned int i = 0; i < n; ++i)
+        moved2 = std::max(moved2, search.separation(s.x[i], x_at_build[i]).norm_square());
+    if (x_at_build.size() == n && search.period == prm.period &&
+        cutoff + 2 * std::sqrt(moved2) <= built_cutoff)
+      return;
+    search.period = prm.period;
+    built_cutoff  = cutoff * (1 + prm.neighbour_skin);
+    search.build(s.x, built_cutoff);
+    x_at_build = s.x;
+    ++builds;
+  }
+
+  template <int dim>
   void Solver<dim>::compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k)
   {
     const unsigned int n = s.size();
@@ -73,8 +91,7 @@ namespace tribo::sph
     double h_max = 0;
     for (unsigned int i = 0; i < n; ++i)
       h_max = std::max(h_max, s.h[i]);
-    search.period = prm.period;
-    search.build(s.x, std::max(2 * h_max, prm.boundary.range()));
+    update_neighbours(s, std::max(2 * h_max, prm.boundary.range()));
 
     // Per-particle pressure, longitudinal sound speed and sigma/rho^2.
     std::vector<double>                  c(n);

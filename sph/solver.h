@@ -36,6 +36,11 @@ namespace tribo::sph
     /// L_i where det M_i < 0.05^dim (M = I with a full
     /// kernel support, ~2^-dim I at a corner). false: the paper's eqs. (20), (24) as written.
     bool corrected_gradient = true;
+    /// Verlet skin of the neighbour list, as a fraction of the cut-off c = max(2 h_max,
+    /// boundary range): the list holds the pairs within c (1 + skin) and is rebuilt only
+    /// when c + 2 max_i |x_i - x_i(at the build)| exceeds that. The rates do not depend on
+    /// it (pairs beyond c are skipped); 0 rebuilds at every evaluation.
+    double neighbour_skin = 0.1;
   };
 
   /// Particles whose velocity is imposed (e.g. the top layers moved
@@ -159,8 +164,11 @@ namespace tribo::sph
     const Rates<dim> &last_rates() const { return k2; }
     /// Name of the limit that set the last step ("CFL", "acceleration", "dt_max", "dt_limit").
     const std::string &last_limiter() const { return limiter; }
-    /// The neighbour search (as of the last evaluation).
+    /// The neighbour search (as of the last evaluation): every pair within the cut-off,
+    /// and some beyond it (SolverParameters::neighbour_skin).
     const NeighbourSearch<dim> &neighbours() const { return search; }
+    /// Neighbour-list builds since construction (the skin saves the others).
+    unsigned long n_neighbour_builds() const { return builds; }
     const std::vector<Material> &materials() const { return mats; }
     const SolverParameters &parameters() const { return prm; }
 
@@ -184,6 +192,11 @@ namespace tribo::sph
     ParticleState<dim>    mid;
     std::string           limiter;
     double                damped_energy = 0; ///< J, see damping_dissipation()
+    std::vector<Tensor<1, dim>> x_at_build;    ///< positions at the last list build, m
+    double                      built_cutoff = 0; ///< the list's cut-off c (1 + skin), m
+    unsigned long               builds = 0;
+    /// Rebuild the neighbour list if a pair within @p cutoff may be missing from it.
+    void update_neighbours(const ParticleState<dim> &s, double cutoff);
   };
 
   /// SPH interpolation at the particles, f~_i = sum_j (m_j/rho_j) f_j W_ij
