@@ -117,7 +117,8 @@ namespace tribo::app
     prm.declare_entry("Density", "7800", Double(), "Density of discs, walls and first bodies, kg/m^3 (> 0).");
     prm.declare_entry("Length", "1e-4", Double(), "Period L along x, m (> 0; paper: 1e-4).");
     prm.declare_entry("Wall discs", "72", Integer(0),
-                      "Discs in each rough wall, spread evenly along L (paper: 72); 0 gives L/d.");
+                      "Discs in each rough wall, spread evenly along L (paper: 72); 0 gives about L/d "
+                      "(d: Wall disc diameter if given, else the mean diameter).");
     prm.declare_entry("Wall disc diameter", "0", Double(0),
                       "Diameter of every wall disc, m (>= 0); 0: drawn from the grains' distribution "
                       "(the paper's walls).");
@@ -248,6 +249,9 @@ namespace tribo::app
           f.fail(S + "Length", "a length of at least 8 largest diameters (" + to_text(8 * d_max) + " m)");
         sc.wall_discs         = f.get_integer(S + "Wall discs");
         sc.wall_disc_diameter = f.get_double(S + "Wall disc diameter");
+        if (sc.wall_disc_diameter > sc.length / 8)
+          f.fail(S + "Wall disc diameter", "a diameter of at most L/8 = " + to_text(sc.length / 8) +
+                                             " m (a wall of at least 8 discs), or 0");
         const double d_wall   = sc.wall_disc_diameter > 0 ? sc.wall_disc_diameter
                                                           : sc.mean_diameter * (1 - sc.diameter_spread);
         if (sc.wall_discs > 0 && sc.wall_discs * d_wall > sc.length * (1 + 1e-12))

@@ -315,8 +315,12 @@ namespace tribo::app
       unsigned int add_wall(dem::ParticleSystem &s, double y)
       {
         const auto        &k = prm.shear;
-        const unsigned int n = k.wall_discs > 0 ? k.wall_discs
-                                                : std::max(1u, unsigned(std::round(k.length / k.mean_diameter)));
+        // 0 wall discs: about L/d of them (d the mean or the given wall disc diameter),
+        // and never more than fit along L when their diameter is given.
+        const double d = k.wall_disc_diameter > 0 ? k.wall_disc_diameter : k.mean_diameter;
+        unsigned int n = k.wall_discs > 0 ? k.wall_discs : std::max(1u, unsigned(std::round(k.length / d)));
+        if (k.wall_discs == 0 && k.wall_disc_diameter > 0 && n > 1 && n * d > k.length * (1 + 1e-12))
+          --n;
         std::vector<double>    radii(n);
         std::vector<dem::Vec2> centres(n);
         for (unsigned int i = 0; i < n; ++i)

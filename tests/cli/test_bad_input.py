@@ -199,6 +199,18 @@ class MeaninglessValues(BadInputTestCase):
         # d (1 - s) = 0.96e-6 m: at most 12 discs fit along 1.2e-5 m.
         self.shear_entry("Wall discs", "13", "at most 12 discs")
 
+    def test_wall_disc_too_large(self):
+        # L/8 = 1.5e-6 m for L = 1.2e-5 m.
+        self.shear_entry("Wall disc diameter", "2e-6",
+                         "a diameter of at most L/8 = 1.5e-06 m (a wall of at least 8 discs), or 0")
+
+    def test_wall_discs_of_a_given_diameter_must_fit(self):
+        # 1.2e-6 m discs: 10 fit along 1.2e-5 m, 11 do not.
+        sections = {"Simulation": {"Scene": "shear"},
+                    "Shear cell": {"Number of discs": "60", "Length": "1.2e-5", "Wall discs": "11",
+                                   "Wall disc diameter": "1.2e-6"}}
+        self.check_entry("Shear cell/Wall discs", "11", "at most 10 discs", sections)
+
     def test_negative_cohesion(self):
         self.check_entry("Contact law/Cohesion", "-1", "a cohesion >= 0 in N/m")
 
