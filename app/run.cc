@@ -25,6 +25,8 @@
 #include <filesystem>
 #include <sstream>
 
+#include <sys/resource.h>
+
 namespace tribo::app
 {
   namespace fs = std::filesystem;
@@ -71,6 +73,14 @@ namespace tribo::app
       // The scene's own fields, SERIES_NNNNN.vtu, indexed in SERIES.pvd.
       for (const std::string &file : scene.write_fields(writer.directory(), writer.n_snapshots() - 1))
         writer.index(file.substr(0, file.rfind('_')), t, file);
+    }
+
+    /// Peak resident memory of the process so far, MB (getrusage; Linux reports KiB).
+    double peak_memory_mb()
+    {
+      rusage usage{};
+      getrusage(RUSAGE_SELF, &usage);
+      return usage.ru_maxrss / 1024.0;
     }
 
     /// Where the steps' wall time goes, over the steps of this process (since the start
@@ -310,6 +320,15 @@ namespace tribo::app
       if (!scene->description().empty())
         log(scene->description());
     }
+    // What building the case cost: the modules a case does not use are not built (a rigid
+    // wall builds no deal.II, SPH or MLP object).
+    const double setup_time   = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double setup_memory = peak_memory_mb();
+    {
+      std::ostringstream os;
+      os << "set-up " << setup_time << " s, peak memory " << setup_memory << " MB";
+      log(os.str());
+    }
 
     std::vector<std::string> columns = common_columns;
     for (const auto &c : scene->columns())
@@ -460,6 +479,9 @@ namespace tribo::app
     summary.set("n_discs", long(system.discs.size()));
     summary.set("n_field_snapshots", long(fields.n_snapshots()));
     summary.set("timing", timing.to_json());
+    summary.set("setup_time", setup_time);
+    summary.set("setup_peak_memory", setup_memory);
+    summary.set("peak_memory", peak_memory_mb());
     JsonObject scene_results;
     if (!stats.rows().empty())
       scene->summarize(system, stats, scene_results);
