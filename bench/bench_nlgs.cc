@@ -84,7 +84,7 @@ int main(int argc, char **argv)
   t0 = Clock::now();
   const auto   rep     = solver.solve(frozen, state, mj.law());
   const double elapsed = seconds_since(t0);
-  const double updates = double(rep.iterations) * frozen.size();
+  const double updates = double(rep.iterations + rep.check_passes) * frozen.size();
   std::printf("NLGS: %u sweeps over %zu contacts in %.3f s: %.3g contact updates per second "
               "(%.1f ns per update)\n",
               rep.iterations, frozen.size(), elapsed, updates / elapsed, 1e9 * elapsed / updates);

@@ -82,6 +82,51 @@ namespace tribo::dem
     is >> rng;
   }
 
+  namespace
+  {
+    /// The established code's convergence sums over one pass (docs/laws.md,
+    /// "Convergence norms"), fed with each contact's impulse before and after its local
+    /// solve.
+    struct CheckSums
+    {
+      double       wrwr = 0, wrr = 0, dvdv = 0, dvdvrr = 0, dvor = 0;
+      double       max_dvdv = 0, max_dvdvrr = 0;
+      unsigned int active = 0; ///< contacts with a non-zero mean impulse
+
+      void add(const Eigen::Matrix2d &W, const Eigen::Vector2d &r_old, const Eigen::Vector2d &r_new)
+      {
+        const Eigen::Vector2d r_bar = 0.5 * (r_old + r_new);
+        if (r_bar.x() == 0 && r_bar.y() == 0)
+          return;
+        ++active;
+        const Eigen::Vector2d dv     = W * (r_new - r_old);
+        const Eigen::Vector2d wr_old = W * r_old, wr_new = W * r_new;
+        const double          d2     = dv.squaredNorm();
+        wrwr += 0.5 * (wr_old.squaredNorm() + wr_new.squaredNorm());
+        wrr += 0.5 * (wr_old.dot(r_old) + wr_new.dot(r_new));
+        dvdv += d2;
+        dvdvrr += d2 * r_bar.squaredNorm();
+        dvor += r_bar.dot(dv);
+        max_dvdv   = std::max(max_dvdv, d2);
+        max_dvdvrr = std::max(max_dvdvrr, d2 * r_bar.squaredNorm());
+      }
+
+      /// max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm ones), relative to @p tol.
+      double criterion(NlgsParameters::Norm norm, double tol) const
+      {
+        const double N         = active;
+        const double quad_wr   = std::sqrt(wrwr / N);
+        const double mean_wrr  = wrr / N;
+        const double mean_dvor = wrr > 0 ? dvor / (wrr * tol) : 0;
+        const bool   quad      = norm == NlgsParameters::Norm::quad;
+        const double dv_norm   = quad_wr > 0 ? std::sqrt(quad ? dvdv / N : max_dvdv) / (quad_wr * tol) : 0;
+        const double dvr_norm =
+          mean_wrr > 0 ? std::sqrt(quad ? dvdvrr / N : max_dvdvrr) / (mean_wrr * tol) : 0;
+        return std::max({std::abs(mean_dvor), dv_norm, dvr_norm});
+      }
+    };
+  } // namespace
+
   NlgsReport NlgsSolver::solve(std::vector<Contact> &contacts, BodyState &state,
                                const ContactLaw &law, double theta_h)
   {
@@ -94,20 +139,16 @@ namespace tribo::dem
     for (auto &c : contacts)
       c.u = state.local_velocity(c);
 
-    const double tol   = prm.tolerance;
-    const double omega = prm.relaxation;
-    report.converged   = false;
+    const double tol      = prm.tolerance;
+    const double omega    = prm.relaxation;
+    const bool   iqs      = law.type == ContactLaw::Type::iqs;
+    report.converged      = false;
     for (unsigned int sweep = 1; sweep <= prm.max_iterations; ++sweep)
       {
         if (prm.order == NlgsParameters::Order::random)
           std::shuffle(order.begin(), order.end(), rng);
         else if (prm.order == NlgsParameters::Order::alternating && sweep > 1)
           std::reverse(order.begin(), order.end());
-        const bool check = (sweep % prm.check_interval == 0) || sweep == prm.max_iterations;
-        double     sum_wrwr = 0, sum_wrr = 0, sum_dvdv = 0, sum_dvdvrr = 0, sum_dvor = 0;
-        double     max_dvdv = 0, max_dvdvrr = 0, max_violation = 0;
-        const bool iqs = law.type == ContactLaw::Type::iqs;
-        unsigned int active = 0;
         for (const unsigned int a : order)
           {
             Contact              &c       = contacts[a];
@@ -121,55 +162,37 @@ namespace tribo::dem
             const Eigen::Vector2d dr = r_new - r_old;
             if (dr.x() != 0 || dr.y() != 0)
               state.apply_impulse(c, dr);
-            const Eigen::Vector2d u_after = u_now + c.W * dr;
-            if (check && iqs)
-              max_violation = std::max(max_violation, -(u_after.x() + c.shift));
-            if (check && (r_new.x() != 0 || r_new.y() != 0))
-              {
-                ++active;
-                const Eigen::Vector2d dv     = c.W * dr; // = u_after - u_now
-                const Eigen::Vector2d r_bar  = 0.5 * (r_old + r_new);
-                const Eigen::Vector2d wr_old = c.W * r_old, wr_new = c.W * r_new;
-                const double wrr  = 0.5 * (wr_old.dot(r_old) + wr_new.dot(r_new));
-                const double dvdv = dv.squaredNorm();
-                sum_wrwr += 0.5 * (wr_old.squaredNorm() + wr_new.squaredNorm());
-                sum_wrr += wrr;
-                sum_dvdv += dvdv;
-                sum_dvdvrr += dvdv * r_bar.squaredNorm();
-                sum_dvor += r_bar.dot(dv);
-                max_dvdv   = std::max(max_dvdv, dvdv);
-                max_dvdvrr = std::max(max_dvdvrr, dvdv * r_bar.squaredNorm());
-              }
             c.r = r_new;
-            c.u = u_after;
+            c.u = u_now + c.W * dr;
           }
         report.iterations = sweep;
-        if (!check)
+        if (sweep % prm.check_interval != 0 && sweep != prm.max_iterations)
           continue;
+        // The check pass: every contact's local solve against the state the sweeps left,
+        // nothing applied (as the established code does: a sweep's own changes would
+        // measure where the sweep went, not how far the state is from the solution).
+        ++report.check_passes;
+        CheckSums sums;
+        double    max_violation = 0;
+        for (const unsigned int a : order)
+          {
+            const Contact          &c       = contacts[a];
+            const Eigen::Vector2d   u_now   = state.local_velocity(c);
+            const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
+            const Eigen::Vector2d   r_law   = law.solve(c.W, u_now - c.W * c.r, terms);
+            if (iqs)
+              max_violation = std::max(max_violation, -(u_now.x() + c.shift));
+            sums.add(c.W, c.r, r_law);
+          }
         report.gap_violation = theta_h * std::max(0.0, max_violation);
         const bool gaps_ok   = prm.gap_tolerance <= 0 || report.gap_violation <= prm.gap_tolerance;
-        if (active == 0)
+        if (sums.active == 0)
           {
             report.converged = true;
             report.residual  = 0;
             break;
           }
-        const double N         = active;
-        const double quad_wr   = std::sqrt(sum_wrwr / N);
-        const double mean_wrr  = sum_wrr / N;
-        const double mean_dvor = sum_wrr > 0 ? sum_dvor / (sum_wrr * tol) : 0;
-        double dv_norm, dvr_norm;
-        if (prm.norm == NlgsParameters::Norm::quad)
-          {
-            dv_norm  = quad_wr > 0 ? std::sqrt(sum_dvdv / N) / (quad_wr * tol) : 0;
-            dvr_norm = mean_wrr > 0 ? std::sqrt(sum_dvdvrr / N) / (mean_wrr * tol) : 0;
-          }
-        else
-          {
-            dv_norm  = quad_wr > 0 ? std::sqrt(max_dvdv) / (quad_wr * tol) : 0;
-            dvr_norm = mean_wrr > 0 ? std::sqrt(max_dvdvrr) / (mean_wrr * tol) : 0;
-          }
-        const double criterion = std::max({std::abs(mean_dvor), dv_norm, dvr_norm});
+        const double criterion = sums.criterion(prm.norm, tol);
         report.residual        = criterion * tol;
         if (criterion < 1 && gaps_ok)
           {

@@ -68,7 +68,10 @@ namespace tribo::dem
   /// What one solve achieved.
   struct NlgsReport
   {
-    unsigned int iterations = 0;    ///< sweeps done
+    unsigned int iterations   = 0; ///< sweeps done (check passes not included)
+    /// Convergence checks done: passes of local solves that apply nothing, one every
+    /// `check_interval` sweeps (their cost is part of the solver's time).
+    unsigned int check_passes = 0;
     bool         converged  = true;
     /// The achieved criterion: max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm
     /// ones) times tol, i.e. the relative quantity that is compared with tol.

@@ -54,6 +54,23 @@ TEST(Dynamics, DiscOnAFixedWallCarriesTheAppliedForceAfterOneStep)
   EXPECT_NEAR(s.bodies[disc].velocity.norm(), 0.0, 1e-13 * 1e-8 * std::abs(F) / s.bodies[disc].mass);
 }
 
+TEST(Dynamics, CheckPassMeasuresTheStateAndAppliesNothing)
+{
+  // One contact: the first sweep's local solve is exact, so the check pass after it
+  // (check interval 1) finds nothing left to change and the solver stops there. A check
+  // that measured the sweep's own change instead would see the whole impulse move and
+  // need a second sweep. The pass applies nothing: the velocities are the sweep's.
+  ParticleSystem s = pair(2.0, 1e-9);
+  MoreauJean     mj(0.5, ContactLaw{}, tight(), 1e-8);
+  const auto     rep = mj.step(s, 1e-9).solver; // closes the 1e-9 m gap at 2 m/s
+  EXPECT_TRUE(rep.converged);
+  EXPECT_EQ(rep.iterations, 1u);
+  EXPECT_EQ(rep.check_passes, 1u);
+  EXPECT_EQ(rep.residual, 0.0);
+  ASSERT_EQ(mj.contacts().size(), 1u);
+  EXPECT_GT(mj.contacts()[0].r.x(), 0.0);
+}
+
 TEST(Dynamics, IqsHeadOnCollisionConservesMomentumAndStopsTheApproach)
 {
   ParticleSystem s = pair(2.0, 1e-9);
@@ -205,21 +222,26 @@ TEST(Dynamics, NlgsSolutionSatisfiesSignorini)
       state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
       state.inverse_mass.push_back(b.inverse_mass());
     }
+  // The tolerance is relative to W r, about 33 m/s here (r = 1e-7 N s/m on a 6e-9 kg/m
+  // disc): 1e-6 of it is 3.3e-5 m/s. The Quad norm is a mean square over the contacts,
+  // so the loaded contacts' mean square violation is held to 3 times that and the worst
+  // one to 30 times.
   unsigned loaded = 0;
+  double   sum_square = 0, worst = 0;
   for (const auto &c : mj.contacts())
     {
-      const double un    = state.local_velocity(c).x();
-      // The tolerance is relative to W r, about 33 m/s here (r = 1e-7 N s/m on a
-      // 6e-9 kg/m disc): 1e-6 of it is 3.3e-5 m/s, 3.3e-5 of the wall speed.
-      const double scale = 100.0;
+      const double un = state.local_velocity(c).x();
       EXPECT_GE(c.r.x(), 0.0);
-      EXPECT_GE(un + c.shift, -1e-6 * scale);
+      EXPECT_GE(un + c.shift, -1e-3);
       if (c.r.x() > 0)
         {
           ++loaded;
-          EXPECT_NEAR(un + c.shift, 0.0, 1e-6 * scale);
+          sum_square += (un + c.shift) * (un + c.shift);
+          worst = std::max(worst, std::abs(un + c.shift));
         }
     }
+  EXPECT_LT(std::sqrt(sum_square / loaded), 1e-4);
+  EXPECT_LT(worst, 1e-3);
   EXPECT_GT(loaded, 10u);
 }
 
