@@ -1,8 +1,11 @@
 // NLGS throughput on a dense packing: compacts a case (default
 // cases/shear/bench.prm, ~3000 discs at 100 MPa), then times
 //  (1) fixed sweeps over the frozen contact set: contact updates per second;
-//  (2) full steps at the case's tolerance: sweeps, contacts and wall time per step.
-// Usage: bench_nlgs [CASE.prm] [compaction steps] [timed steps]
+//  (2) full steps at the case's tolerance: sweeps, contacts and wall time per step, split
+//      into detection, NLGS and the rest (free state, local problems, update);
+//  and the resident memory the packing added, per disc.
+// Usage: bench_nlgs [CASE.prm] [compaction steps] [timed steps] [--set "Section/Entry=value"]...
+// (bench/nlgs_scaling.sh runs it on 1k to 64k discs.)
 #include "app/case_parameters.h"
 #include "app/scene.h"
 #include "core/parameter_file.h"
@@ -10,7 +13,9 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <string>
+#include <vector>
 
 using namespace tribo;
 using Clock = std::chrono::steady_clock;
@@ -21,18 +26,39 @@ namespace
   {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   }
+
+  /// Resident memory of the process now, MB (/proc/self/status VmRSS).
+  double resident_mb()
+  {
+    std::ifstream in("/proc/self/status");
+    std::string   key;
+    double        kib = 0;
+    while (in >> key)
+      if (key == "VmRSS:" && in >> kib)
+        break;
+    return kib / 1024.0;
+  }
 } // namespace
 
 int main(int argc, char **argv)
 {
-  const std::string case_file     = argc > 1 ? argv[1] : "cases/shear/bench.prm";
-  const unsigned    compact_steps = argc > 2 ? std::stoul(argv[2]) : 3000;
-  const unsigned    timed_steps   = argc > 3 ? std::stoul(argv[3]) : 100;
+  std::vector<std::string> positional, overrides;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--set" && i + 1 < argc)
+      overrides.push_back(argv[++i]);
+    else
+      positional.push_back(argv[i]);
+  const std::string case_file     = positional.size() > 0 ? positional[0] : "cases/shear/bench.prm";
+  const unsigned    compact_steps = positional.size() > 1 ? std::stoul(positional[1]) : 3000;
+  const unsigned    timed_steps   = positional.size() > 2 ? std::stoul(positional[2]) : 100;
+  const double      memory_before = resident_mb();
 
   dealii::ParameterHandler prm;
   app::declare_case_parameters(prm);
   ParameterFile file(prm);
   file.parse(case_file);
+  for (const auto &o : overrides)
+    file.set(o);
   const app::CaseParameters p = app::read_case_parameters(file);
 
   auto                scene = app::make_scene(p);
@@ -51,7 +77,9 @@ int main(int argc, char **argv)
   std::printf("compaction: %u steps in %.2f s\n", compact_steps, seconds_since(t0));
 
   // (2) steps at the case's tolerance (warm-started, as in a run).
+  const double  memory_per_disc = 1e6 * (resident_mb() - memory_before) / system.discs.size();
   unsigned long sweeps = 0, contacts = 0, active = 0;
+  double        detection = 0, solver_time = 0, step_total = 0;
   t0 = Clock::now();
   for (unsigned s = 0; s < timed_steps; ++s)
     {
@@ -60,6 +88,9 @@ int main(int argc, char **argv)
       sweeps += r.solver.iterations;
       contacts += r.n_contacts;
       active += r.n_active;
+      detection += r.time_detection;
+      solver_time += r.time_solver;
+      step_total += r.time_step;
     }
   const double step_time = seconds_since(t0) / timed_steps;
   std::printf("steps at tol %g (%s, check every %u): %.4f s per step, %.1f sweeps, %.0f contacts "
@@ -67,6 +98,14 @@ int main(int argc, char **argv)
               p.solver.tolerance, p.solver.norm == dem::NlgsParameters::Norm::quad ? "Quad" : "Maxm",
               p.solver.check_interval, step_time, double(sweeps) / timed_steps,
               double(contacts) / timed_steps, double(active) / timed_steps);
+  std::printf("per step: detection %.3f ms, NLGS %.3f ms, rest (free state, local problems, "
+              "update) %.3f ms; per disc: detection %.1f ns, rest %.1f ns\n",
+              1e3 * detection / timed_steps, 1e3 * solver_time / timed_steps,
+              1e3 * (step_total - detection - solver_time) / timed_steps,
+              1e9 * detection / timed_steps / system.discs.size(),
+              1e9 * (step_total - detection - solver_time) / timed_steps / system.discs.size());
+  std::printf("memory: %.0f bytes per disc (resident growth after compaction, %.1f MB in all)\n",
+              memory_per_disc, resident_mb() - memory_before);
 
   // (1) fixed sweeps on the last step's contacts, from their converged impulses.
   std::vector<dem::Contact> frozen = mj.contacts();
