@@ -72,6 +72,11 @@ namespace tribo::app
                       "top), 'alternating' (that order and its reverse in turn, a symmetric Gauss-Seidel) "
                       "or 'random' (shuffled every sweep).");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the random contact order.");
+    prm.declare_entry("Threads", "1", Integer(1),
+                      "Bands of contacts solved at once, >= 1 (1: the serial sweep). T > 1 cuts the "
+                      "contacts (rows of cells, bottom to top) into 2T bands and solves the even bands "
+                      "concurrently, then the odd ones: a Gauss-Seidel sweep in that band order, the "
+                      "same result on any number of cores. Needs Contact order = fixed.");
     prm.declare_entry("Gap tolerance", "0", Double(),
                       "Extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
                       "0: off, the established code's norms only): every contact's gap violation "
@@ -212,6 +217,10 @@ namespace tribo::app
                      : order == "alternating" ? dem::NlgsParameters::Order::alternating
                                               : dem::NlgsParameters::Order::fixed;
     p.solver.seed           = f.get_integer("Solver/Seed");
+    p.solver.threads        = f.get_integer("Solver/Threads");
+    if (p.solver.threads > 1 && p.solver.order != dem::NlgsParameters::Order::fixed)
+      f.fail("Solver/Threads", "1 with Solver/Contact order = " + order +
+                                 " (bands solved at once need the fixed order)");
     p.gap_tolerance         = f.get_checked("Solver/Gap tolerance", non_negative, "a fraction >= 0 of the smallest radius");
 
     p.statistics_interval = f.get_integer("Output/Statistics interval");

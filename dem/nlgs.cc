@@ -1,5 +1,7 @@
 #include "dem/nlgs.h"
 
+#include <deal.II/base/parallel.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -111,6 +113,18 @@ namespace tribo::dem
         max_dvdvrr = std::max(max_dvdvrr, d2 * r_bar.squaredNorm());
       }
 
+      void merge(const CheckSums &o)
+      {
+        wrwr += o.wrwr;
+        wrr += o.wrr;
+        dvdv += o.dvdv;
+        dvdvrr += o.dvdvrr;
+        dvor += o.dvor;
+        max_dvdv   = std::max(max_dvdv, o.max_dvdv);
+        max_dvdvrr = std::max(max_dvdvrr, o.max_dvdvrr);
+        active += o.active;
+      }
+
       /// max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm ones), relative to @p tol.
       double criterion(NlgsParameters::Norm norm, double tol) const
       {
@@ -127,6 +141,34 @@ namespace tribo::dem
     };
   } // namespace
 
+  namespace
+  {
+    /// Whether the bands [begin[k], begin[k+1]) of each phase (k even, k odd) touch
+    /// disjoint bodies, the boundary body's nodes counting as one more body.
+    bool bands_independent(const std::vector<Contact> &contacts, const std::vector<unsigned int> &begin,
+                           std::size_t n_bodies)
+    {
+      std::vector<int> owner(n_bodies + 1);
+      for (unsigned int phase = 0; phase < 2; ++phase)
+        {
+          std::fill(owner.begin(), owner.end(), -1);
+          for (unsigned int k = phase; k + 1 < begin.size(); k += 2)
+            for (unsigned int i = begin[k]; i < begin[k + 1]; ++i)
+              {
+                const Contact &c     = contacts[i];
+                const std::size_t ids[2] = {c.on_boundary() ? n_bodies : c.body[0], c.body[1]};
+                for (const std::size_t b : ids)
+                  {
+                    if (owner[b] >= 0 && owner[b] != int(k))
+                      return false;
+                    owner[b] = int(k);
+                  }
+              }
+        }
+      return true;
+    }
+  } // namespace
+
   NlgsReport NlgsSolver::solve(std::vector<Contact> &contacts, BodyState &state,
                                const ContactLaw &law, double theta_h)
   {
@@ -139,50 +181,96 @@ namespace tribo::dem
     for (auto &c : contacts)
       c.u = state.local_velocity(c);
 
-    const double tol      = prm.tolerance;
-    const double omega    = prm.relaxation;
-    const bool   iqs      = law.type == ContactLaw::Type::iqs;
-    report.converged      = false;
+    const double tol   = prm.tolerance;
+    const double omega = prm.relaxation;
+    const bool   iqs   = law.type == ContactLaw::Type::iqs;
+    report.converged   = false;
+
+    // Bands: [begin[k], begin[k + 1]) in the order; one band for the serial sweep.
+    const unsigned int         n_bands = prm.threads > 1 && n >= 2 * prm.threads ? 2 * prm.threads : 1;
+    std::vector<unsigned int> begin(n_bands + 1);
+    for (unsigned int k = 0; k <= n_bands; ++k)
+      begin[k] = static_cast<unsigned int>(n * k / n_bands);
+    report.concurrent = n_bands > 1 && bands_independent(contacts, begin, state.velocity.size());
+
+    auto solve_band = [&](unsigned int k) {
+      for (unsigned int i = begin[k]; i < begin[k + 1]; ++i)
+        {
+          Contact              &c       = contacts[order[i]];
+          const Eigen::Vector2d u_now   = state.local_velocity(c);
+          const Eigen::Vector2d r_old   = c.r;
+          const Eigen::Vector2d u_other = u_now - c.W * r_old;
+          const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
+          Eigen::Vector2d       r_new   = law.solve(c.W, u_other, terms);
+          if (omega != 1.0)
+            r_new = omega * r_new + (1 - omega) * r_old;
+          const Eigen::Vector2d dr = r_new - r_old;
+          if (dr.x() != 0 || dr.y() != 0)
+            state.apply_impulse(c, dr);
+          c.r = r_new;
+          c.u = u_now + c.W * dr;
+        }
+    };
+    // The check pass over band k: every contact's local solve against the state the
+    // sweeps left, nothing applied (as the established code does: a sweep's own changes
+    // would measure where the sweep went, not how far the state is from the solution).
+    std::vector<CheckSums> band_sums(n_bands);
+    std::vector<double>    band_violation(n_bands);
+    auto check_band = [&](unsigned int k) {
+      CheckSums sums;
+      double    violation = 0;
+      for (unsigned int i = begin[k]; i < begin[k + 1]; ++i)
+        {
+          const Contact          &c     = contacts[order[i]];
+          const Eigen::Vector2d   u_now = state.local_velocity(c);
+          const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
+          const Eigen::Vector2d   r_law = law.solve(c.W, u_now - c.W * c.r, terms);
+          if (iqs)
+            violation = std::max(violation, -(u_now.x() + c.shift));
+          sums.add(c.W, c.r, r_law);
+        }
+      band_sums[k]      = sums;
+      band_violation[k] = violation;
+    };
+    // Bands k = first, first + 2, ...: concurrently when they share no body.
+    auto over_bands = [&](unsigned int first, unsigned int step, const auto &work) {
+      const unsigned int count = (n_bands - first + step - 1) / step;
+      if (report.concurrent && count > 1)
+        dealii::parallel::apply_to_subranges(
+          0u, count, [&](unsigned int b, unsigned int e) {
+            for (unsigned int j = b; j < e; ++j)
+              work(first + j * step);
+          },
+          1);
+      else
+        for (unsigned int j = 0; j < count; ++j)
+          work(first + j * step);
+    };
+
     for (unsigned int sweep = 1; sweep <= prm.max_iterations; ++sweep)
       {
         if (prm.order == NlgsParameters::Order::random)
           std::shuffle(order.begin(), order.end(), rng);
         else if (prm.order == NlgsParameters::Order::alternating && sweep > 1)
           std::reverse(order.begin(), order.end());
-        for (const unsigned int a : order)
+        if (n_bands == 1)
+          solve_band(0);
+        else
           {
-            Contact              &c       = contacts[a];
-            const Eigen::Vector2d u_now   = state.local_velocity(c);
-            const Eigen::Vector2d r_old   = c.r;
-            const Eigen::Vector2d u_other = u_now - c.W * r_old;
-            const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
-            Eigen::Vector2d       r_new   = law.solve(c.W, u_other, terms);
-            if (omega != 1.0)
-              r_new = omega * r_new + (1 - omega) * r_old;
-            const Eigen::Vector2d dr = r_new - r_old;
-            if (dr.x() != 0 || dr.y() != 0)
-              state.apply_impulse(c, dr);
-            c.r = r_new;
-            c.u = u_now + c.W * dr;
+            over_bands(0, 2, solve_band);
+            over_bands(1, 2, solve_band);
           }
         report.iterations = sweep;
         if (sweep % prm.check_interval != 0 && sweep != prm.max_iterations)
           continue;
-        // The check pass: every contact's local solve against the state the sweeps left,
-        // nothing applied (as the established code does: a sweep's own changes would
-        // measure where the sweep went, not how far the state is from the solution).
         ++report.check_passes;
+        over_bands(0, 1, check_band);
         CheckSums sums;
         double    max_violation = 0;
-        for (const unsigned int a : order)
+        for (unsigned int k = 0; k < n_bands; ++k)
           {
-            const Contact          &c       = contacts[a];
-            const Eigen::Vector2d   u_now   = state.local_velocity(c);
-            const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
-            const Eigen::Vector2d   r_law   = law.solve(c.W, u_now - c.W * c.r, terms);
-            if (iqs)
-              max_violation = std::max(max_violation, -(u_now.x() + c.shift));
-            sums.add(c.W, c.r, r_law);
+            sums.merge(band_sums[k]);
+            max_violation = std::max(max_violation, band_violation[k]);
           }
         report.gap_violation = theta_h * std::max(0.0, max_violation);
         const bool gaps_ok   = prm.gap_tolerance <= 0 || report.gap_violation <= prm.gap_tolerance;

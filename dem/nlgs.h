@@ -4,14 +4,15 @@
 /// local solve reads its contact's velocity from them (no off-diagonal W stored).
 ///
 /// Convergence is checked every `check_interval` sweeps with the norms of the
-/// established NSCD code (LMGC90, see ../shared/notes/nscd-reference.md), over the
-/// N contacts with r != 0, comparing each contact's state before and after its
-/// local solve in the checked sweep, with W its own 2x2 Delassus block:
-/// dV = W (r_after - r_before), the change of its velocity in that solve (m/s),
-/// r_bar = (r_before + r_after)/2, WR = W r (m/s), WRR = (W r.r before + after)/2.
-/// (dV is not the change of u since the previous sweep: a closed IQS contact
-/// leaves every local solve at exactly its target velocity, so that difference
-/// stays near zero however far its impulse still moves.)
+/// established NSCD code (LMGC90, see ../shared/notes/nscd-reference.md), in a check
+/// pass that solves every contact's local problem against the current state and applies
+/// nothing, over the N contacts with a non-zero mean impulse, with W the contact's own
+/// 2x2 Delassus block, r its impulse and r_after the check's solution:
+/// dV = W (r_after - r), the change of velocity the contact still wants (m/s),
+/// r_bar = (r + r_after)/2, WR = W r (m/s), WRR = (W r.r before + after)/2.
+/// (dV is neither the change of u since the previous sweep, blind to a closed IQS
+/// contact whose impulse still moves, nor a sweep's own change, which carries what the
+/// contacts before it in the sweep just did: docs/laws.md.)
 /// - QuadWR = sqrt(sum (|WR_before|^2 + |WR_after|^2)/2 / N), MeanWRR = sum WRR / N;
 /// - QuadDV = sqrt(sum |dV|^2 / N) / (QuadWR tol), MaxmDV with max |dV|^2;
 /// - QuadDVR = sqrt(sum |dV|^2 |r_bar|^2 / N) / (MeanWRR tol), MaxmDVR with the max;
@@ -56,6 +57,14 @@ namespace tribo::dem
     };
     Order        order          = Order::fixed;
     unsigned int seed           = 1;
+    /// Bands solved at once (1: the plain serial sweep). With T > 1 the contacts, in
+    /// detection order (rows of cells, bottom to top), are cut into 2T bands of equal
+    /// count; a sweep solves the even bands concurrently, then the odd ones. Bands of
+    /// one phase share no body, so the sweep is the serial Gauss-Seidel sweep in the
+    /// order 0, 2, ..., 1, 3, ...: the result depends on T, never on the scheduling. If
+    /// a solve's bands do share a body (a thin packing), that solve runs the same
+    /// order serially. Needs Order::fixed.
+    unsigned int threads = 1;
     /// Extra criterion (0: off): also require, for every IQS contact, the gap
     /// violation theta h max(0, -(u_n + shift)) to be at most this, m. The norms
     /// above measure how much a sweep changes the solution, not how far it is
@@ -72,6 +81,9 @@ namespace tribo::dem
     /// Convergence checks done: passes of local solves that apply nothing, one every
     /// `check_interval` sweeps (their cost is part of the solver's time).
     unsigned int check_passes = 0;
+    /// With NlgsParameters::threads > 1: whether the bands were solved concurrently
+    /// (false: they shared a body and were solved serially, in the same order).
+    bool concurrent = false;
     bool         converged  = true;
     /// The achieved criterion: max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm
     /// ones) times tol, i.e. the relative quantity that is compared with tol.

@@ -228,6 +228,12 @@ class MeaninglessValues(BadInputTestCase):
     def test_zero_relaxation(self):
         self.check_entry("Solver/Relaxation", "0", "a relaxation in (0, 1]")
 
+    def test_bands_need_the_fixed_order(self):
+        sections = case({"Solver/Threads": "2", "Solver/Contact order": "random"})
+        self.check_entry("Solver/Threads", "2",
+                         "1 with Solver/Contact order = random (bands solved at once need the fixed order)",
+                         sections)
+
     def test_zero_impact_velocity(self):
         self.check_entry("Collision/Impact velocity", "0", "a non-zero velocity in m/s")
 

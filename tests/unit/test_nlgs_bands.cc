@@ -1,0 +1,129 @@
+// The banded NLGS (NlgsParameters::threads > 1): the concurrent sweep is the serial
+// Gauss-Seidel sweep in the band order, bit for bit, and a run with it keeps the
+// energy balance of every step.
+#include "dem/moreau_jean.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+using namespace tribo::dem;
+
+namespace
+{
+  const double rho = 7800, radius = 0.5e-6;
+
+  /// A hexagonal stack of 8 x 24 discs (d = 1 um, 2 % gaps) between a sliding lower
+  /// wall and a loaded upper wall, period 8 um: tall enough for four bands of contacts.
+  ParticleSystem tall_layer()
+  {
+    ParticleSystem s;
+    s.period = 8e-6;
+    std::vector<Vec2>   c;
+    std::vector<double> rad;
+    for (int i = 0; i < 8; ++i)
+      {
+        c.push_back({(i + 0.5) * 1e-6, 0});
+        rad.push_back(radius);
+      }
+    const unsigned lower = s.add_clump(c, rad, rho);
+    for (auto &d : s.bodies[lower].drive)
+      d = Drive::velocity;
+    s.bodies[lower].velocity = {1.0, 0};
+    const double dy = 1.02e-6 * std::sqrt(3.0) / 2;
+    for (int j = 0; j < 24; ++j)
+      for (int i = 0; i < 8; ++i)
+        s.add_disc({(i + 0.5 * (j % 2)) * 1.02e-6, 1.02e-6 + j * dy}, radius, rho);
+    for (auto &p : c)
+      p.y() = 1.02e-6 + 24 * dy;
+    const unsigned upper = s.add_clump(c, rad, rho);
+    s.bodies[upper].drive   = {{Drive::velocity, Drive::force, Drive::velocity}};
+    s.bodies[upper].load[1] = -800.0;
+    s.bodies[upper].velocity = {0, -1.0};
+    return s;
+  }
+
+  BodyState state_of(const ParticleSystem &s)
+  {
+    BodyState state;
+    for (const auto &b : s.bodies)
+      {
+        state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
+        state.inverse_mass.push_back(b.inverse_mass());
+      }
+    return state;
+  }
+} // namespace
+
+TEST(NlgsBands, ConcurrentSweepIsTheSerialSweepInBandOrder)
+{
+  ParticleSystem s = tall_layer();
+  NlgsParameters prm;
+  prm.tolerance = 1e-3;
+  MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);
+  for (int i = 0; i < 20; ++i)
+    mj.step(s, 1e-9);
+  std::vector<Contact> contacts = mj.contacts();
+  ASSERT_GT(contacts.size(), 300u);
+  for (auto &c : contacts)
+    c.r.setZero(); // a cold start: 40 sweeps of real work
+
+  NlgsParameters fixed;
+  fixed.tolerance      = 1e-300; // never converges: exactly max_iterations sweeps
+  fixed.max_iterations = 40;
+  fixed.check_interval = 10;
+  fixed.threads        = 2;
+
+  std::vector<Contact> banded = contacts;
+  BodyState            banded_state = state_of(s);
+  const NlgsReport     rep          = NlgsSolver(fixed).solve(banded, banded_state, mj.law());
+  EXPECT_TRUE(rep.concurrent);
+  EXPECT_EQ(rep.iterations, 40u);
+
+  // The same contacts reordered band 0, 2, 1, 3 and swept serially.
+  const std::size_t    n = contacts.size();
+  std::vector<Contact> serial;
+  for (const unsigned int k : {0u, 2u, 1u, 3u})
+    for (std::size_t i = n * k / 4; i < n * (k + 1) / 4; ++i)
+      serial.push_back(contacts[i]);
+  fixed.threads          = 1;
+  BodyState serial_state = state_of(s);
+  NlgsSolver(fixed).solve(serial, serial_state, mj.law());
+
+  unsigned int moved = 0;
+  for (std::size_t j = 0, i = 0; j < 4; ++j)
+    {
+      const unsigned int k = j == 0 ? 0 : j == 1 ? 2 : j == 2 ? 1 : 3;
+      for (std::size_t a = n * k / 4; a < n * (k + 1) / 4; ++a, ++i)
+        {
+          EXPECT_EQ(banded[a].r.x(), serial[i].r.x()) << "contact " << a;
+          EXPECT_EQ(banded[a].r.y(), serial[i].r.y()) << "contact " << a;
+          moved += banded[a].r.x() != 0 ? 1 : 0;
+        }
+    }
+  EXPECT_GT(moved, 100u);
+  for (std::size_t b = 0; b < s.bodies.size(); ++b)
+    EXPECT_EQ(banded_state.velocity[b], serial_state.velocity[b]) << "body " << b;
+}
+
+TEST(NlgsBands, RunKeepsTheEnergyBalanceOfEveryStep)
+{
+  ParticleSystem s = tall_layer();
+  NlgsParameters prm;
+  prm.tolerance = 1e-4;
+  prm.threads   = 2;
+  MoreauJean   mj(0.5, ContactLaw{}, prm, 5e-8);
+  unsigned int concurrent = 0;
+  for (int i = 0; i < 100; ++i)
+    {
+      const double ke0 = s.kinetic_energy();
+      const auto   rep = mj.step(s, 1e-9);
+      const double dke = rep.kinetic_energy - ke0;
+      const double rhs = 1e-9 * (rep.power_external + rep.power_contacts);
+      EXPECT_NEAR(dke, rhs, 1e-9 * (std::abs(dke) + std::abs(rhs)) + 1e-25) << "step " << i;
+      EXPECT_TRUE(rep.solver.converged) << "step " << i;
+      concurrent += rep.solver.concurrent ? 1 : 0;
+    }
+  EXPECT_GT(concurrent, 90u);
+}
