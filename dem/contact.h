@@ -25,7 +25,6 @@ namespace tribo::dem
     double arm_n[2] = {0, 0}, arm_t[2] = {0, 0};
     Eigen::Matrix2d W      = Eigen::Matrix2d::Zero(); ///< own Delassus block sum_b H_b^T M_b^-1 H_b, m/s per N s/m
     Eigen::Vector2d r      = Eigen::Vector2d::Zero(); ///< impulse, N s/m
-    Eigen::Vector2d u      = Eigen::Vector2d::Zero(); ///< local velocity after its last local solve, m/s
     Eigen::Vector2d u_free = Eigen::Vector2d::Zero(); ///< local velocity of the free motion (no impulses), m/s
     double cohesion_impulse = 0, shift = 0, compliance = 0; ///< law terms (ContactLaw::Terms)
     /// Against a half-disc element of a BoundaryBody (dem/boundary.h): its index, else -1.

@@ -128,8 +128,7 @@ namespace tribo::dem
         c.shift            = terms.shift;
         c.compliance       = terms.compliance;
         c.u_free           = state.local_velocity(c);
-        const auto it      = previous_impulse.find(c.key());
-        c.r                = it != previous_impulse.end() ? it->second : Eigen::Vector2d::Zero();
+        c.r                = previous_impulse.find(c.key());
         current.push_back(c);
       }
     report.n_contacts = current.size();
@@ -142,7 +141,7 @@ namespace tribo::dem
     report.time_solver = seconds_since(phase);
 
     // Gap measures with the final velocities.
-    previous_impulse.clear();
+    next_impulse.clear();
     double eps_sum = 0, min_gap_end = 0, min_gap_any = 0;
     for (const Contact &c : current)
       {
@@ -151,12 +150,13 @@ namespace tribo::dem
             min_gap_any = std::min(min_gap_any, c.gap + th * h * state.local_velocity(c).x());
             continue;
           }
-        previous_impulse[c.key()] = c.r;
+        next_impulse.emplace_back(c.key(), c.r);
         ++report.n_active;
         const double un = state.local_velocity(c).x();
         eps_sum += th * h * (un - c.u_free.x());
         min_gap_end = std::min(min_gap_end, c.gap + th * h * un);
       }
+    previous_impulse.assign(next_impulse);
     report.epsilon     = report.n_active ? eps_sum / report.n_active : 0;
     report.max_overlap = std::max(0.0, -min_gap_end);
     const double deepest_overlap = std::max(report.max_overlap, -min_gap_any); // any contact
@@ -275,14 +275,33 @@ namespace tribo::dem
     return report;
   }
 
+  void WarmStart::assign(const std::vector<Entry> &list)
+  {
+    std::size_t owners = 0;
+    for (const auto &e : list)
+      owners = std::max<std::size_t>(owners, static_cast<std::uint32_t>(e.first) + 1);
+    start.assign(owners + 1, 0);
+    for (const auto &e : list)
+      ++start[static_cast<std::uint32_t>(e.first) + 1];
+    for (std::size_t o = 0; o < owners; ++o)
+      start[o + 1] += start[o];
+    entries.resize(list.size());
+    std::vector<unsigned int> fill(start.begin(), start.end() - 1);
+    for (const auto &e : list)
+      entries[fill[static_cast<std::uint32_t>(e.first)]++] = e;
+  }
+
+  std::vector<WarmStart::Entry> WarmStart::sorted() const
+  {
+    std::vector<Entry> out = entries;
+    std::sort(out.begin(), out.end(), [](const Entry &a, const Entry &b) { return a.first < b.first; });
+    return out;
+  }
+
   void MoreauJean::save(CheckpointOut &ar) const
   {
-    // Sorted by key: the file does not depend on the hash table's layout.
-    std::vector<std::pair<std::uint64_t, Eigen::Vector2d>> impulses(previous_impulse.begin(),
-                                                                    previous_impulse.end());
-    std::sort(impulses.begin(), impulses.end(),
-              [](const auto &a, const auto &b) { return a.first < b.first; });
-    std::size_t n = impulses.size();
+    const std::vector<WarmStart::Entry> impulses = previous_impulse.sorted();
+    std::size_t                         n        = impulses.size();
     ar << n;
     for (const auto &[key, r] : impulses)
       ar << key << r.x() << r.y();
@@ -293,14 +312,10 @@ namespace tribo::dem
   {
     std::size_t n;
     ar >> n;
-    previous_impulse.clear();
-    for (std::size_t i = 0; i < n; ++i)
-      {
-        std::uint64_t key;
-        double        rn, rt;
-        ar >> key >> rn >> rt;
-        previous_impulse[key] = {rn, rt};
-      }
+    std::vector<WarmStart::Entry> impulses(n);
+    for (auto &[key, r] : impulses)
+      ar >> key >> r.x() >> r.y();
+    previous_impulse.assign(impulses);
     std::string random;
     ar >> random;
     solver.set_random_state(random);

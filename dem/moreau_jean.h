@@ -16,8 +16,9 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <memory>
-#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace tribo::dem
@@ -52,6 +53,36 @@ namespace tribo::dem
     /// finalize()), and the NLGS solve; the rest is setting up the local problems and
     /// the update of the discs.
     double time_step = 0, time_detection = 0, time_boundary_body = 0, time_solver = 0;
+  };
+
+  /// The previous step's contact impulses, for the warm start: (key, r) grouped by the
+  /// key's low 32 bits (the larger disc of a disc pair, the grain of a half-disc
+  /// contact), so a lookup scans the few contacts of one grain, stored side by side.
+  /// Rebuilt each step by a counting sort, O(contacts + discs); a hash table did the
+  /// same with one allocation per contact and a cache miss per lookup.
+  class WarmStart
+  {
+  public:
+    using Entry = std::pair<std::uint64_t, Eigen::Vector2d>;
+    /// Replace the content by @p list (any order; keys distinct).
+    void assign(const std::vector<Entry> &list);
+    /// The impulse stored for @p key, zero if none.
+    Eigen::Vector2d find(std::uint64_t key) const
+    {
+      const std::size_t owner = static_cast<std::uint32_t>(key);
+      if (owner + 1 >= start.size())
+        return Eigen::Vector2d::Zero();
+      for (unsigned int i = start[owner]; i < start[owner + 1]; ++i)
+        if (entries[i].first == key)
+          return entries[i].second;
+      return Eigen::Vector2d::Zero();
+    }
+    /// Every entry, sorted by key (checkpoints: independent of the storage).
+    std::vector<Entry> sorted() const;
+
+  private:
+    std::vector<unsigned int> start; ///< entries of owner o: [start[o], start[o + 1])
+    std::vector<Entry>        entries;
   };
 
   /// The integrator; it owns the contacts of the current step.
@@ -92,7 +123,8 @@ namespace tribo::dem
     double                   distance;
     ContactDetector          detector;
     std::vector<Contact>     current;
-    std::unordered_map<std::uint64_t, Eigen::Vector2d> previous_impulse;
+    WarmStart                previous_impulse;
+    std::vector<WarmStart::Entry> next_impulse; ///< this step's, before it becomes the previous
     BodyState                state;
     std::vector<Eigen::Vector3d> body_force;
     std::vector<double>          body_power;

@@ -178,8 +178,6 @@ namespace tribo::dem
       return report;
     order.resize(n);
     std::iota(order.begin(), order.end(), 0u);
-    for (auto &c : contacts)
-      c.u = state.local_velocity(c);
 
     const double tol   = prm.tolerance;
     const double omega = prm.relaxation;
@@ -208,7 +206,6 @@ namespace tribo::dem
           if (dr.x() != 0 || dr.y() != 0)
             state.apply_impulse(c, dr);
           c.r = r_new;
-          c.u = u_now + c.W * dr;
         }
     };
     // The check pass over band k: every contact's local solve against the state the
