@@ -190,6 +190,18 @@ namespace tribo::dem
     for (unsigned int k = 0; k <= n_bands; ++k)
       begin[k] = static_cast<unsigned int>(n * k / n_bands);
     report.concurrent = n_bands > 1 && bands_independent(contacts, begin, state.velocity.size());
+    if (prm.order == NlgsParameters::Order::fixed && prm.streams > 1)
+      for (unsigned int k = 0; k < n_bands; ++k)
+        {
+          // Band k's contacts in streams of `chunk`, one from each stream in turn.
+          const unsigned int size = begin[k + 1] - begin[k], streams = prm.streams;
+          const unsigned int chunk = (size + streams - 1) / streams;
+          unsigned int       i     = begin[k];
+          for (unsigned int j = 0; j < chunk; ++j)
+            for (unsigned int s = 0; s < streams; ++s)
+              if (s * chunk + j < size)
+                order[i++] = begin[k] + s * chunk + j;
+        }
 
     auto solve_band = [&](unsigned int k) {
       for (unsigned int i = begin[k]; i < begin[k + 1]; ++i)

@@ -1,5 +1,5 @@
-// The banded NLGS (NlgsParameters::threads > 1): the concurrent sweep is the serial
-// Gauss-Seidel sweep in the band order, bit for bit, and a run with it keeps the
+// The banded NLGS (NlgsParameters::threads > 1) and the interleaved streams: each is the
+// serial Gauss-Seidel sweep in its own order, bit for bit, and a banded run keeps the
 // energy balance of every step.
 #include "dem/moreau_jean.h"
 
@@ -74,6 +74,7 @@ TEST(NlgsBands, ConcurrentSweepIsTheSerialSweepInBandOrder)
   fixed.max_iterations = 40;
   fixed.check_interval = 10;
   fixed.threads        = 2;
+  fixed.streams        = 1; // the band order alone (streams reorder within a band)
 
   std::vector<Contact> banded = contacts;
   BodyState            banded_state = state_of(s);
@@ -126,4 +127,44 @@ TEST(NlgsBands, RunKeepsTheEnergyBalanceOfEveryStep)
       concurrent += rep.solver.concurrent ? 1 : 0;
     }
   EXPECT_GT(concurrent, 90u);
+}
+
+TEST(NlgsBands, StreamsAreTheSerialSweepInInterleavedOrder)
+{
+  // Streams = 4: contacts 0, q, 2q, 3q, 1, q + 1, ... (q = n / 4 rounded up): the same
+  // sweep as the detection-order solver run on the contacts listed in that order.
+  ParticleSystem s = tall_layer();
+  NlgsParameters prm;
+  prm.tolerance = 1e-3;
+  MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);
+  for (int i = 0; i < 20; ++i)
+    mj.step(s, 1e-9);
+  std::vector<Contact> contacts = mj.contacts();
+  for (auto &c : contacts)
+    c.r.setZero();
+  NlgsParameters fixed;
+  fixed.tolerance      = 1e-300;
+  fixed.max_iterations = 40;
+  fixed.streams        = 4;
+  std::vector<Contact> streamed = contacts;
+  BodyState            streamed_state = state_of(s);
+  NlgsSolver(fixed).solve(streamed, streamed_state, mj.law());
+
+  const std::size_t        n = contacts.size(), q = (n + 3) / 4;
+  std::vector<std::size_t> order;
+  for (std::size_t j = 0; j < q; ++j)
+    for (std::size_t k = 0; k < 4; ++k)
+      if (k * q + j < n)
+        order.push_back(k * q + j);
+  ASSERT_EQ(order.size(), n);
+  std::vector<Contact> serial;
+  for (const std::size_t a : order)
+    serial.push_back(contacts[a]);
+  fixed.streams          = 1;
+  BodyState serial_state = state_of(s);
+  NlgsSolver(fixed).solve(serial, serial_state, mj.law());
+  for (std::size_t i = 0; i < n; ++i)
+    EXPECT_EQ(streamed[order[i]].r, serial[i].r) << "contact " << order[i];
+  for (std::size_t b = 0; b < s.bodies.size(); ++b)
+    EXPECT_EQ(streamed_state.velocity[b], serial_state.velocity[b]) << "body " << b;
 }
