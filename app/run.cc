@@ -532,7 +532,7 @@ namespace tribo::app
   {
     if (status == "failed")
       {
-        log("error: " + failure);
+        log.error(failure);
         return exit_run_error;
       }
     if (status == "interrupted")

@@ -154,6 +154,13 @@ namespace tribo
     if (echo)
       std::cout << message << std::endl;
   }
+  void Log::error(const std::string &message)
+  {
+    if (file.is_open())
+      file << "error: " << message << '\n' << std::flush;
+    std::cerr << "error: " << message << std::endl;
+  }
+
   void TimeSeries::save(CheckpointOut &ar) const
   {
     ar << names << data;

@@ -65,6 +65,8 @@ namespace tribo
     Log() = default;
     void open(const std::string &path, bool echo_to_terminal);
     void operator()(const std::string &message);
+    /// "error: message" to log.txt and to stderr, quiet or not.
+    void error(const std::string &message);
 
   private:
     std::ofstream file;

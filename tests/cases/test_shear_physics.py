@@ -169,6 +169,10 @@ class WallThroughLayer(unittest.TestCase):
             with open(os.path.join(out, "summary.json")) as f:
                 summary = json.load(f)
             self.assertEqual(summary["status"], "failed")
+            # --quiet silences progress, not the reason: it is on stderr and in log.txt.
+            self.assertEqual(p.stderr.strip(), "error: " + summary["error"])
+            with open(os.path.join(out, "log.txt")) as f:
+                self.assertIn("error: " + summary["error"], f.read())
             # The first symptom stops it: grains overlapping by more than a radius, with
             # the fastest mover and a step that keeps it within a quarter radius.
             self.assertIn("more than the smallest disc radius", summary["error"])
