@@ -259,15 +259,19 @@ namespace tribo::dem
         os << "an overlap of " << deepest_overlap << " m, more than the smallest disc radius ("
            << r_min << " m): contacts were missed or left unresolved (NLGS "
            << (report.solver.converged ? "converged" : "not converged") << "). ";
-        if (speed * h > 0.1 * r_min)
+        if (speed * h > 0.25 * r_min)
           os << "The fastest mover, "
              << (fastest.first >= fastest_node ? "body " + std::to_string(fastest.second)
                                                : std::string("a node of the deformable upper body"))
              << ", moved " << speed * h << " m in the step (" << speed << " m/s); a step of at most "
              << 0.25 * r_min / speed << " s keeps it within a quarter of the smallest radius";
         else
-          os << "No body moved more than a tenth of the smallest radius in the step: the overlap "
-                "does not come from the step size (discs placed overlapping?)";
+          os << "No body moved more than a quarter of the smallest radius in the step: the "
+                "overlap does not come from the step size. Either discs were placed overlapping, "
+                "or the law lets it grow: with IQS, overlaps kept step after step within the "
+                "solver's tolerance (high pressure: tighten Solver/Tolerance or Solver/Gap "
+                "tolerance, or set Contact law/Overlap recovery); with ELAS, a stiffness too low "
+                "for the load (docs/laws.md)";
         throw RunError(os.str());
       }
     report.kinetic_energy = system.kinetic_energy();
