@@ -35,7 +35,7 @@ MATRIX = [
     ("cohesion", "gamma = 1e3 N/m (10 P d)", SHEAR, {"Contact law/Cohesion": "1e3"}),
     ("cohesion", "gamma = 1e5 N/m (1000 P d)", SHEAR, {"Contact law/Cohesion": "1e5"}),
     ("ELAS stiffness", "ELAS k = 1e8", SHEAR, {"Contact law/Law": "ELAS", "Contact law/Stiffness": "1e8"}),
-    ("ELAS stiffness", "ELAS k = 1e10 (h = 2e-9, 7 x the contact time)", SHEAR,
+    ("ELAS stiffness", "ELAS k = 1e10 (h = 3 x the contact time)", SHEAR,
      {"Contact law/Law": "ELAS", "Contact law/Stiffness": "1e10"}),
     ("ELAS stiffness", "ELAS k = 1e13", SHEAR, {"Contact law/Law": "ELAS", "Contact law/Stiffness": "1e13"}),
     ("first body E", "fem E = 3e9", SHEAR, {"Shear cell/Upper body model": "fem", "Shear cell/Upper body Young's modulus": "3e9"}),
