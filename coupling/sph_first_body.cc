@@ -75,7 +75,7 @@ namespace tribo::coupling
       {
         std::ostringstream os;
         os << "sph upper body: " << solver.state.size() << " particles (" << n_nodes() << " x " << ny
-           << ", spacing " << spacing << " m, h = " << prm.smoothing_ratio << " s), E = " << prm.youngs_modulus
+           << ", spacing " << spacing << " m, smoothing length " << prm.smoothing_ratio << " x spacing), E = " << prm.youngs_modulus
            << " Pa, nu = " << prm.poisson_ratio << ", c_p = " << p_wave_speed(prm) << " m/s";
         return os.str();
       }
