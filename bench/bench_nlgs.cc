@@ -109,12 +109,7 @@ int main(int argc, char **argv)
 
   // (1) fixed sweeps on the last step's contacts, from their converged impulses.
   std::vector<dem::Contact> frozen = mj.contacts();
-  dem::BodyState            state;
-  for (const auto &b : system.bodies)
-    {
-      state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
-      state.inverse_mass.push_back(b.inverse_mass());
-    }
+  dem::BodyState            state  = dem::BodyState::of(system);
   dem::NlgsParameters fixed = p.solver;
   fixed.tolerance           = 1e-300; // never converges: exactly max_iterations sweeps
   fixed.max_iterations      = 200;

@@ -111,6 +111,18 @@ namespace tribo::dem
     Eigen::VectorXd        node_velocity;
     const Eigen::MatrixXd *node_compliance = nullptr;
 
+    /// The current velocities and inverse masses of @p system's bodies (no boundary body).
+    static BodyState of(const ParticleSystem &system)
+    {
+      BodyState state;
+      for (const auto &b : system.bodies)
+        {
+          state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
+          state.inverse_mass.push_back(b.inverse_mass());
+        }
+      return state;
+    }
+
     /// Local velocity of contact @p c from the current body velocities.
     Eigen::Vector2d local_velocity(const Contact &c) const
     {

@@ -61,11 +61,7 @@ namespace
       MoreauJean mj(0.5, ContactLaw{}, NlgsParameters{}, 0.5e-6);
       mj.step(system, 1e-12); // builds the contacts with their arms
       contacts = mj.contacts();
-      for (const auto &b : system.bodies)
-        {
-          state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
-          state.inverse_mass.push_back(b.inverse_mass());
-        }
+      state    = BodyState::of(system);
     }
   };
 } // namespace

@@ -216,12 +216,7 @@ TEST(Dynamics, NlgsSolutionSatisfiesSignorini)
   EXPECT_LT(capped, 20u);
   // Recompute every contact's final local velocity from the bodies: with r_n > 0
   // the end-of-step gap is closed (u_n = -shift), with r_n = 0 it stays open.
-  BodyState state;
-  for (const auto &b : s.bodies)
-    {
-      state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
-      state.inverse_mass.push_back(b.inverse_mass());
-    }
+  const BodyState state = BodyState::of(s);
   // The tolerance is relative to W r, about 33 m/s here (r = 1e-7 N s/m on a 6e-9 kg/m
   // disc): 1e-6 of it is 3.3e-5 m/s. The Quad norm is a mean square over the contacts,
   // so the loaded contacts' mean square violation is held to 3 times that and the worst

@@ -44,41 +44,50 @@ namespace
     return s;
   }
 
-  BodyState state_of(const ParticleSystem &s)
+  /// The contacts of tall_layer() after 20 steps, with their impulses reset (a cold
+  /// start: the fixed sweeps below have real work to do), and the state they act on.
+  struct ColdStart
   {
-    BodyState state;
-    for (const auto &b : s.bodies)
-      {
-        state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
-        state.inverse_mass.push_back(b.inverse_mass());
-      }
-    return state;
+    ParticleSystem       system = tall_layer();
+    ContactLaw           law;
+    std::vector<Contact> contacts;
+    ColdStart()
+    {
+      NlgsParameters prm;
+      prm.tolerance = 1e-3;
+      MoreauJean mj(0.5, law, prm, 5e-8);
+      for (int i = 0; i < 20; ++i)
+        mj.step(system, 1e-9);
+      contacts = mj.contacts();
+      for (auto &c : contacts)
+        c.r.setZero();
+    }
+  };
+
+  /// Exactly @p sweeps sweeps (a tolerance never met).
+  NlgsParameters fixed_sweeps(unsigned int sweeps)
+  {
+    NlgsParameters p;
+    p.tolerance      = 1e-300;
+    p.max_iterations = sweeps;
+    return p;
   }
 } // namespace
 
 TEST(NlgsBands, ConcurrentSweepIsTheSerialSweepInBandOrder)
 {
-  ParticleSystem s = tall_layer();
-  NlgsParameters prm;
-  prm.tolerance = 1e-3;
-  MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);
-  for (int i = 0; i < 20; ++i)
-    mj.step(s, 1e-9);
-  std::vector<Contact> contacts = mj.contacts();
+  const ColdStart             cold;
+  const ParticleSystem       &s        = cold.system;
+  const std::vector<Contact> &contacts = cold.contacts;
   ASSERT_GT(contacts.size(), 300u);
-  for (auto &c : contacts)
-    c.r.setZero(); // a cold start: 40 sweeps of real work
-
-  NlgsParameters fixed;
-  fixed.tolerance      = 1e-300; // never converges: exactly max_iterations sweeps
-  fixed.max_iterations = 40;
+  NlgsParameters fixed = fixed_sweeps(40);
   fixed.check_interval = 10;
   fixed.threads        = 2;
   fixed.streams        = 1; // the band order alone (streams reorder within a band)
 
   std::vector<Contact> banded = contacts;
-  BodyState            banded_state = state_of(s);
-  const NlgsReport     rep          = NlgsSolver(fixed).solve(banded, banded_state, mj.law());
+  BodyState            banded_state = BodyState::of(s);
+  const NlgsReport     rep          = NlgsSolver(fixed).solve(banded, banded_state, cold.law);
   EXPECT_TRUE(rep.concurrent);
   EXPECT_EQ(rep.iterations, 40u);
 
@@ -89,8 +98,8 @@ TEST(NlgsBands, ConcurrentSweepIsTheSerialSweepInBandOrder)
     for (std::size_t i = n * k / 4; i < n * (k + 1) / 4; ++i)
       serial.push_back(contacts[i]);
   fixed.threads          = 1;
-  BodyState serial_state = state_of(s);
-  NlgsSolver(fixed).solve(serial, serial_state, mj.law());
+  BodyState serial_state = BodyState::of(s);
+  NlgsSolver(fixed).solve(serial, serial_state, cold.law);
 
   unsigned int moved = 0;
   for (std::size_t j = 0, i = 0; j < 4; ++j)
@@ -133,22 +142,14 @@ TEST(NlgsBands, StreamsAreTheSerialSweepInInterleavedOrder)
 {
   // Streams = 4: contacts 0, q, 2q, 3q, 1, q + 1, ... (q = n / 4 rounded up): the same
   // sweep as the detection-order solver run on the contacts listed in that order.
-  ParticleSystem s = tall_layer();
-  NlgsParameters prm;
-  prm.tolerance = 1e-3;
-  MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);
-  for (int i = 0; i < 20; ++i)
-    mj.step(s, 1e-9);
-  std::vector<Contact> contacts = mj.contacts();
-  for (auto &c : contacts)
-    c.r.setZero();
-  NlgsParameters fixed;
-  fixed.tolerance      = 1e-300;
-  fixed.max_iterations = 40;
-  fixed.streams        = 4;
+  const ColdStart             cold;
+  const ParticleSystem       &s        = cold.system;
+  const std::vector<Contact> &contacts = cold.contacts;
+  NlgsParameters              fixed    = fixed_sweeps(40);
+  fixed.streams                        = 4;
   std::vector<Contact> streamed = contacts;
-  BodyState            streamed_state = state_of(s);
-  NlgsSolver(fixed).solve(streamed, streamed_state, mj.law());
+  BodyState            streamed_state = BodyState::of(s);
+  NlgsSolver(fixed).solve(streamed, streamed_state, cold.law);
 
   const std::size_t        n = contacts.size(), q = (n + 3) / 4;
   std::vector<std::size_t> order;
@@ -161,8 +162,8 @@ TEST(NlgsBands, StreamsAreTheSerialSweepInInterleavedOrder)
   for (const std::size_t a : order)
     serial.push_back(contacts[a]);
   fixed.streams          = 1;
-  BodyState serial_state = state_of(s);
-  NlgsSolver(fixed).solve(serial, serial_state, mj.law());
+  BodyState serial_state = BodyState::of(s);
+  NlgsSolver(fixed).solve(serial, serial_state, cold.law);
   for (std::size_t i = 0; i < n; ++i)
     EXPECT_EQ(streamed[order[i]].r, serial[i].r) << "contact " << order[i];
   for (std::size_t b = 0; b < s.bodies.size(); ++b)
