@@ -184,8 +184,10 @@ namespace tribo::dem
     const bool   iqs   = law.type == ContactLaw::Type::iqs;
     report.converged   = false;
 
-    // Bands: [begin[k], begin[k + 1]) in the order; one band for the serial sweep.
-    const unsigned int         n_bands = prm.threads > 1 && n >= 2 * prm.threads ? 2 * prm.threads : 1;
+    // Bands: [begin[k], begin[k + 1]) in the order; one band for the serial sweep (and for
+    // the orders that move contacts between bands: random, alternating).
+    const bool         banded  = prm.threads > 1 && n >= 2 * prm.threads && prm.order == NlgsParameters::Order::fixed;
+    const unsigned int n_bands = banded ? 2 * prm.threads : 1;
     std::vector<unsigned int> begin(n_bands + 1);
     for (unsigned int k = 0; k <= n_bands; ++k)
       begin[k] = static_cast<unsigned int>(n * k / n_bands);

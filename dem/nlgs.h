@@ -70,7 +70,7 @@ namespace tribo::dem
     /// one phase share no body, so the sweep is the serial Gauss-Seidel sweep in the
     /// order 0, 2, ..., 1, 3, ...: the result depends on T, never on the scheduling. If
     /// a solve's bands do share a body (a thin packing), that solve runs the same
-    /// order serially. Needs Order::fixed.
+    /// order serially. Needs Order::fixed (other orders ignore it: one band).
     unsigned int threads = 1;
     /// Extra criterion (0: off): also require, for every IQS contact, the gap
     /// violation theta h max(0, -(u_n + shift)) to be at most this, m. The norms
