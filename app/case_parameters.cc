@@ -72,7 +72,7 @@ namespace tribo::app
                       "top), 'alternating' (that order and its reverse in turn, a symmetric Gauss-Seidel) "
                       "or 'random' (shuffled every sweep).");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the random contact order.");
-    prm.declare_entry("Streams", "1", Integer(1),
+    prm.declare_entry("Streams", "4", Integer(1),
                       "With Contact order = fixed: the order cut into this many streams of "
                       "consecutive contacts, solved one from each in turn, >= 1 (1: the detection "
                       "order itself). Far-apart contacts share no body, so the processor overlaps "
@@ -82,7 +82,8 @@ namespace tribo::app
                       "Bands of contacts solved at once, >= 1 (1: the serial sweep). T > 1 cuts the "
                       "contacts (rows of cells, bottom to top) into 2T bands and solves the even bands "
                       "concurrently, then the odd ones: a Gauss-Seidel sweep in that band order, the "
-                      "same result on any number of cores. Needs Contact order = fixed.");
+                      "same result on any number of cores. Needs Contact order = fixed. The contact "
+                      "detection also runs in T threads (the same contacts whatever T).");
     prm.declare_entry("Gap tolerance", "0", Double(),
                       "Extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
                       "0: off, the established code's norms only): every contact's gap violation "
@@ -152,10 +153,12 @@ namespace tribo::app
     prm.declare_entry("Layer thickness", "0", Double(),
                       "Thickness of the profile layers, m (>= 0); 0: one mean diameter.");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
-    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|sph|mlp"),
+    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
                       "rigid: a rough wall of discs with the mass of the first body (the paper's "
                       "classical model); fem: a plane-strain elastic body of that thickness "
-                      "(deal.II), touched through half-disc elements (the paper's hybrid model); "
+                      "(deal.II), touched through half-disc elements (the paper's hybrid model); reduced: "
+                      "that body condensed onto its contact nodes plus Upper body modes vibration modes "
+                      "(Craig-Bampton), cheaper than fem, exact in the static limit; "
                       "sph, mlp: the same body as an SPH (square lattice) or movable-lattice-particle "
                       "(hexagonal lattice) block whose bottom row of particles carries the half-discs, "
                       "sub-cycled inside each contact step (docs/first_bodies.md).");
@@ -171,6 +174,9 @@ namespace tribo::app
                       "Smoothing length over particle spacing of the sph upper body (in [1, 2]).");
     prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
                       "Degree p of the fem upper body's Q_p elements.");
+    prm.declare_entry("Upper body modes", "20", Integer(0),
+                      "Fixed-interface vibration modes kept by the reduced upper body (>= 0; 0: static "
+                      "condensation plus the load mode only), docs/fem.md.");
     prm.declare_entry("Upper body mass damping", "0", Double(),
                       "Rayleigh coefficient a of C = a M + b K for the fem upper body, 1/s (>= 0).");
     prm.declare_entry("Upper body stiffness damping", "0", Double(),
@@ -290,6 +296,7 @@ namespace tribo::app
                                                "a Poisson ratio in (-1, 0.5)");
         sc.upper_cell_size = f.get_checked(S + "Upper body cell size", non_negative, "a size >= 0 in m");
         sc.upper_degree = f.get_integer(S + "Upper body element degree");
+        sc.upper_modes  = f.get_integer(S + "Upper body modes");
         sc.upper_mass_damping = f.get_checked(S + "Upper body mass damping", non_negative, "a coefficient >= 0 in 1/s");
         sc.upper_stiffness_damping = f.get_checked(S + "Upper body stiffness damping", non_negative, "a coefficient >= 0 in s");
         sc.half_disc_diameter = f.get_checked(S + "Half-disc diameter", non_negative, "a diameter >= 0 in m");
@@ -319,6 +326,7 @@ namespace tribo::app
     b.density            = k.density;
     b.resolution         = k.upper_cell_size > 0 ? k.upper_cell_size : k.mean_diameter * (1 - k.diameter_spread);
     b.degree             = k.upper_degree;
+    b.modes              = k.upper_modes;
     b.rayleigh_mass      = k.upper_mass_damping;
     b.rayleigh_stiffness = k.upper_stiffness_damping;
     b.theta              = p.theta;

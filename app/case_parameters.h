@@ -54,7 +54,8 @@ namespace tribo::app
     /// diameter d(1-s)
     double       upper_cell_size;
     double       sph_smoothing_ratio;   ///< h / spacing (sph)
-    unsigned int upper_degree;          ///< Q_p element degree (fem)
+    unsigned int upper_degree;          ///< Q_p element degree (fem, reduced)
+    unsigned int upper_modes;           ///< fixed-interface modes kept (reduced)
     double       upper_mass_damping;    ///< Rayleigh a, 1/s (fem)
     double       upper_stiffness_damping; ///< Rayleigh b, s (fem)
     double       half_disc_diameter;    ///< m (fem); 0: the cell size

@@ -1,9 +1,11 @@
 // Factorisation and solve times of the iteration matrix Mt = M + theta h C + theta^2 h^2 K
 // of the deal.II elastic body with CHOLMOD and UMFPACK, on the paper's body
 // (L = 1e-4 m, H = 1.5e-4 m, Q1): 72 x 107 cells (the paper's 7704), 104 x 156 and
-// 208 x 312 (twice as fine each way).
+// 208 x 312 (twice as fine each way); then the assembly's time on 1 and 2 threads.
 // Usage: bench_fem [repeats (default 5)]     (docs/fem.md records the figures)
 #include "fem/elastic_body.h"
+
+#include <deal.II/base/multithread_info.h>
 
 #include <algorithm>
 #include <chrono>
@@ -94,5 +96,27 @@ int main(int argc, char **argv)
                   c.compliance < u.compliance ? "cholmod" : "umfpack",
                   std::max(c.compliance, u.compliance) / std::min(c.compliance, u.compliance), diff);
     }
+
+  // The assembly (WorkStream over the cells) on 1 and 2 threads.
+  std::printf("assembly of M, K and the unit load, s (best of %u):\n%-11s %8s %10s %10s %8s\n", repeats, "cells",
+              "dofs", "1 thread", "2 threads", "speed-up");
+  for (const auto &mesh : meshes)
+    {
+      double best[2] = {1e300, 1e300};
+      unsigned int dofs = 0;
+      for (unsigned int threads : {1U, 2U})
+        for (unsigned int r = 0; r < repeats; ++r)
+          {
+            dealii::MultithreadInfo::set_thread_limit(threads);
+            tribo::fem::ElasticBodyParameters p;
+            p.cells_x = mesh[0];
+            p.cells_y = mesh[1];
+            const tribo::fem::ElasticBody body(p);
+            best[threads - 1] = std::min(best[threads - 1], body.assembly_seconds());
+            dofs              = body.n_dofs();
+          }
+      std::printf("%4u x %-4u %8u %10.4f %10.4f %8.2f\n", mesh[0], mesh[1], dofs, best[0], best[1], best[0] / best[1]);
+    }
+  dealii::MultithreadInfo::set_thread_limit();
   return 0;
 }

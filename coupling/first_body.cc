@@ -21,13 +21,13 @@ namespace tribo::coupling
   unsigned int chain_nodes(const FirstBodyParameters &p)
   {
     const long n = std::lround(p.length / p.resolution);
-    if (p.model == "fem")
+    if (p.model == "fem" || p.model == "reduced")
       return std::max(1L, n);
     if (p.model == "sph")
       return std::max(8L, n);
     if (p.model == "mlp")
       return std::max(4L, n);
-    throw InputError("unknown upper body model '" + p.model + "': expected rigid, fem, sph or mlp");
+    throw InputError("unknown upper body model '" + p.model + "': expected rigid, fem, reduced, sph or mlp");
   }
 
   double p_wave_speed(const FirstBodyParameters &p)
@@ -66,8 +66,13 @@ namespace tribo::coupling
   {
     const auto        &e = body.parameters();
     std::ostringstream os;
-    os << "fem upper body: " << e.cells_x << " x " << e.cells_y << " Q" << e.degree << " cells, " << body.n_dofs()
-       << " dofs, E = " << e.youngs_modulus << " Pa, nu = " << e.poisson_ratio;
+    os << (e.reduced ? "reduced" : "fem") << " upper body: " << e.cells_x << " x " << e.cells_y << " Q" << e.degree
+       << " cells, " << body.n_dofs() << " dofs";
+    if (e.reduced)
+      os << " reduced to " << body.n_model_dofs() << " (" << 2 * body.n_boundary_nodes() << " boundary, "
+         << e.modes << " modes up to " << (e.modes > 0 ? body.mode_frequencies().back() / (2 * M_PI) : 0.0)
+         << " Hz, 1 load mode)";
+    os << ", E = " << e.youngs_modulus << " Pa, nu = " << e.poisson_ratio;
     return os.str();
   }
 #endif
@@ -97,6 +102,8 @@ namespace tribo::coupling
                          "': expected a cell size giving at most 4e6 cells; it gives " +
                          to_text(double(e.cells_x) * e.cells_y) + " cells");
       e.degree             = p.degree;
+      e.reduced            = p.model == "reduced";
+      e.modes              = p.modes;
       e.rayleigh_mass      = p.rayleigh_mass;
       e.rayleigh_stiffness = p.rayleigh_stiffness;
       e.theta              = p.theta;
@@ -117,12 +124,12 @@ namespace tribo::coupling
   std::unique_ptr<FirstBody> make_first_body(const FirstBodyParameters &p)
   {
     check_first_body(p);
-    if (p.model == "fem")
+    if (p.model == "fem" || p.model == "reduced")
       {
 #ifdef TRIBO_WITH_FEM
         return make_fem_first_body(p);
 #else
-        left_out("fem", "TRIBO_WITH_FEM");
+        left_out(p.model, "TRIBO_WITH_FEM");
 #endif
       }
     if (p.model == "sph")

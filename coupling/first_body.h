@@ -6,6 +6,8 @@
 /// Models (Shear cell/Upper body model):
 /// - fem: the deal.II plane-strain body (fem/), implicit Moreau-Jean, its bottom face
 ///   condensed onto its contact nodes (coupling/elastic_boundary.h);
+/// - reduced: the same body, Craig-Bampton reduced to its contact nodes plus a few
+///   vibration modes and a load mode (fem::ElasticBodyParameters::reduced);
 /// - sph: a solid SPH block (sph/) on a square lattice, linear equation of state;
 /// - mlp: a movable-lattice-particle block (mlp/) on a hexagonal lattice.
 /// The particle models are explicit: their bottom row of particles is the contact chain
@@ -28,7 +30,7 @@ namespace tribo::coupling
   /// Geometry, material and loading of an upper first body (SI units).
   struct FirstBodyParameters
   {
-    std::string  model = "fem"; ///< fem | sph | mlp
+    std::string  model = "fem"; ///< fem | reduced | sph | mlp
     double       length = 0;    ///< L: period along x, m
     double       thickness = 0; ///< H, m
     double       bottom = 0;    ///< y0 of the bottom face (the contact chain), m
@@ -38,7 +40,8 @@ namespace tribo::coupling
     /// Cell size (fem) or particle spacing (sph, mlp), m: the chain has
     /// chain_nodes() = max(minimum, round(L / resolution)) nodes.
     double       resolution = 0;
-    unsigned int degree = 1;            ///< Q_p degree (fem)
+    unsigned int degree = 1;            ///< Q_p degree (fem, reduced)
+    unsigned int modes = 20;            ///< fixed-interface modes kept (reduced)
     double       rayleigh_mass = 0;      ///< a of C = a M + b K while shearing, 1/s (fem)
     double       rayleigh_stiffness = 0; ///< b, s (fem)
     double       theta = 0.5;            ///< Moreau-Jean theta (fem)

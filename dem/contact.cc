@@ -2,6 +2,8 @@
 
 #include "core/errors.h"
 
+#include <deal.II/base/parallel.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -9,7 +11,8 @@
 namespace tribo::dem
 {
   std::vector<Contact> ContactDetector::detect(const ParticleSystem &system,
-                                               const std::vector<Vec2> &centres, double distance)
+                                               const std::vector<Vec2> &centres, double distance,
+                                               unsigned int threads)
   {
     std::vector<Contact> contacts;
     const std::size_t    n = centres.size();
@@ -62,62 +65,88 @@ namespace tribo::dem
         cell_items[fill[cell_of[i]]++] = i;
     }
 
-    for (long cy = 0; cy < ny; ++cy)
-      for (long cx = 0; cx < nx; ++cx)
-        {
-          // The distinct neighbour cells (fewer than 9 when nx or ny < 3).
-          long neighbours[9];
-          int  n_neighbours = 0;
-          for (long dy = -1; dy <= 1; ++dy)
-            for (long dx = -1; dx <= 1; ++dx)
+    // The pairs found in rows [row_begin, row_end) of cells, in the serial order.
+    const auto detect_rows = [&](long row_begin, long row_end, std::vector<Contact> &found) {
+      for (long cy = row_begin; cy < row_end; ++cy)
+        for (long cx = 0; cx < nx; ++cx)
+          {
+            // The distinct neighbour cells (fewer than 9 when nx or ny < 3).
+            long neighbours[9];
+            int  n_neighbours = 0;
+            for (long dy = -1; dy <= 1; ++dy)
+              for (long dx = -1; dx <= 1; ++dx)
+                {
+                  long x = cx + dx, y = cy + dy;
+                  if (y < 0 || y >= ny)
+                    continue;
+                  if (x < 0 || x >= nx)
+                    {
+                      if (!periodic)
+                        continue;
+                      x = (x + nx) % nx;
+                    }
+                  const long c = y * nx + x;
+                  if (std::find(neighbours, neighbours + n_neighbours, c) == neighbours + n_neighbours)
+                    neighbours[n_neighbours++] = c;
+                }
+            const long here = cy * nx + cx;
+            for (unsigned int a = cell_start[here]; a < cell_start[here + 1]; ++a)
               {
-                long x = cx + dx, y = cy + dy;
-                if (y < 0 || y >= ny)
-                  continue;
-                if (x < 0 || x >= nx)
-                  {
-                    if (!periodic)
-                      continue;
-                    x = (x + nx) % nx;
-                  }
-                const long c = y * nx + x;
-                if (std::find(neighbours, neighbours + n_neighbours, c) == neighbours + n_neighbours)
-                  neighbours[n_neighbours++] = c;
+                const unsigned int i = cell_items[a];
+                for (int k = 0; k < n_neighbours; ++k)
+                  for (unsigned int b = cell_start[neighbours[k]]; b < cell_start[neighbours[k] + 1]; ++b)
+                    {
+                      const unsigned int j = cell_items[b];
+                      if (j <= i || system.discs[i].body == system.discs[j].body)
+                        continue;
+                      Vec2 branch = centres[j] - centres[i];
+                      if (periodic)
+                        branch.x() -= system.period * std::round(branch.x() / system.period);
+                      const double ri = system.discs[i].radius, rj = system.discs[j].radius;
+                      const double reach_ij = ri + rj + distance;
+                      const double d2       = branch.squaredNorm();
+                      if (d2 > reach_ij * reach_ij)
+                        continue;
+                      const double dist = std::sqrt(d2);
+                      if (dist == 0)
+                        throw RunError("discs " + std::to_string(i) + " and " + std::to_string(j) +
+                                       " have the same centre: the contact normal is undefined");
+                      Contact c;
+                      c.disc[0] = i;
+                      c.disc[1] = j;
+                      c.body[0] = system.discs[i].body;
+                      c.body[1] = system.discs[j].body;
+                      c.branch  = branch;
+                      c.normal  = branch / dist;
+                      c.gap     = dist - ri - rj;
+                      found.push_back(c);
+                    }
               }
-          const long here = cy * nx + cx;
-          for (unsigned int a = cell_start[here]; a < cell_start[here + 1]; ++a)
-            {
-              const unsigned int i = cell_items[a];
-              for (int k = 0; k < n_neighbours; ++k)
-                for (unsigned int b = cell_start[neighbours[k]]; b < cell_start[neighbours[k] + 1]; ++b)
-                  {
-                    const unsigned int j = cell_items[b];
-                    if (j <= i || system.discs[i].body == system.discs[j].body)
-                      continue;
-                    Vec2 branch = centres[j] - centres[i];
-                    if (periodic)
-                      branch.x() -= system.period * std::round(branch.x() / system.period);
-                    const double ri = system.discs[i].radius, rj = system.discs[j].radius;
-                    const double reach_ij = ri + rj + distance;
-                    const double d2       = branch.squaredNorm();
-                    if (d2 > reach_ij * reach_ij)
-                      continue;
-                    const double dist = std::sqrt(d2);
-                    if (dist == 0)
-                      throw RunError("discs " + std::to_string(i) + " and " + std::to_string(j) +
-                                     " have the same centre: the contact normal is undefined");
-                    Contact c;
-                    c.disc[0] = i;
-                    c.disc[1] = j;
-                    c.body[0] = system.discs[i].body;
-                    c.body[1] = system.discs[j].body;
-                    c.branch  = branch;
-                    c.normal  = branch / dist;
-                    c.gap     = dist - ri - rj;
-                    contacts.push_back(c);
-                  }
-            }
-        }
+          }
+    };
+
+    // Rows of cells in chunks, each chunk's pairs found concurrently and joined in chunk
+    // order: the same contacts in the same order as one pass over all rows.
+    const long n_chunks = threads > 1 ? std::min<long>(ny, 4 * long(threads)) : 1;
+    if (n_chunks == 1)
+      {
+        detect_rows(0, ny, contacts);
+        return contacts;
+      }
+    std::vector<std::vector<Contact>> found(n_chunks);
+    dealii::parallel::apply_to_subranges(
+      0L, n_chunks,
+      [&](long begin, long end) {
+        for (long k = begin; k < end; ++k)
+          detect_rows(ny * k / n_chunks, ny * (k + 1) / n_chunks, found[k]);
+      },
+      1);
+    std::size_t total = 0;
+    for (const auto &f : found)
+      total += f.size();
+    contacts.reserve(total);
+    for (const auto &f : found)
+      contacts.insert(contacts.end(), f.begin(), f.end());
     return contacts;
   }
 } // namespace tribo::dem

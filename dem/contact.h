@@ -54,9 +54,11 @@ namespace tribo::dem
   {
   public:
     /// Contacts (geometry only) for disc centres @p centres (already wrapped
-    /// into [0, period) if periodic) with gap <= @p distance.
+    /// into [0, period) if periodic) with gap <= @p distance. With @p threads > 1
+    /// the rows of cells are searched in 4 @p threads chunks concurrently (TBB through
+    /// deal.II); the contacts and their order do not depend on @p threads.
     std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &centres,
-                                double distance);
+                                double distance, unsigned int threads = 1);
 
   private:
     std::vector<unsigned int> cell_start, cell_items, cell_of;

@@ -73,7 +73,7 @@ namespace tribo::dem
         centres[d] = system.wrap(x_pred[disc.body] + rotate(disc.offset, angle_pred[disc.body]));
       }
     auto                 phase = std::chrono::steady_clock::now();
-    std::vector<Contact> found = detector.detect(system, centres, distance);
+    std::vector<Contact> found = detector.detect(system, centres, distance, solver.parameters().threads);
     report.time_detection      = seconds_since(phase);
 
     // The boundary body: free state, predicted nodes, half-disc contacts.

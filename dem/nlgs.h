@@ -62,15 +62,17 @@ namespace tribo::dem
     /// different streams lie far apart and share no body, so the processor overlaps
     /// their updates instead of waiting on each body's last write: 1.4 times more
     /// contact updates per second on one core at 4 streams, for 3 % more sweeps
-    /// (docs/performance.md). 1 (the default for now): the detection order itself.
-    unsigned int streams = 1;
+    /// (docs/performance.md). 1: the detection order itself.
+    unsigned int streams = 4;
     /// Bands solved at once (1: the plain serial sweep). With T > 1 the contacts, in
     /// detection order (rows of cells, bottom to top), are cut into 2T bands of equal
     /// count; a sweep solves the even bands concurrently, then the odd ones. Bands of
     /// one phase share no body, so the sweep is the serial Gauss-Seidel sweep in the
     /// order 0, 2, ..., 1, 3, ...: the result depends on T, never on the scheduling. If
     /// a solve's bands do share a body (a thin packing), that solve runs the same
-    /// order serially. Needs Order::fixed (other orders ignore it: one band).
+    /// order serially. Needs Order::fixed (other orders ignore it: one band). The
+    /// contact detection of the Moreau-Jean step also searches in T threads (the same
+    /// contacts in the same order whatever T).
     unsigned int threads = 1;
     /// Extra criterion (0: off): also require, for every IQS contact, the gap
     /// violation theta h max(0, -(u_n + shift)) to be at most this, m. The norms

@@ -5,7 +5,9 @@
 #include "core/errors.h"
 
 #include <deal.II/base/function.h>
+#include <deal.II/lac/solver_control.h>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/base/work_stream.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_q.h>
@@ -14,6 +16,7 @@
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/tria.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/arpack_solver.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_direct.h>
@@ -30,11 +33,15 @@
 
 #include <cholmod.h>
 
+#include <Eigen/QR>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 
 namespace tribo::fem
 {
@@ -158,6 +165,20 @@ namespace tribo::fem
       std::size_t     rows = 0;
     };
 
+    std::unique_ptr<DirectSolver> make_direct_solver(const std::string &name)
+    {
+      if (name == "cholmod")
+        return std::make_unique<CholmodSolver>();
+      return std::make_unique<UmfpackSolver>();
+    }
+
+    /// A linear operator given by its action, for deal.II's ArpackSolver.
+    struct ActionOperator
+    {
+      std::function<void(Vector<double> &, const Vector<double> &)> action;
+      void vmult(Vector<double> &dst, const Vector<double> &src) const { action(dst, src); }
+    };
+
     constexpr types::boundary_id left_id = 0, right_id = 1, bottom_id = 2, top_id = 3;
 
     void check(bool ok, const std::string &what)
@@ -178,6 +199,7 @@ namespace tribo::fem
       check(p.pressure_ramp_time >= 0, "pressure ramp time must be >= 0");
       check(p.solver == "cholmod" || p.solver == "umfpack",
             "solver must be \"cholmod\" or \"umfpack\", not \"" + p.solver + "\"");
+      check(!p.reduced || p.cells_y >= 2, "the reduced model needs at least 2 cells along y");
     }
 
     /// A column of the constraint matrix Z: the unconstrained dofs (and weights) a
@@ -189,6 +211,7 @@ namespace tribo::fem
   {
     ElasticBodyParameters prm;
     double                lambda, mu;
+    double                assembly_seconds = 0;
 
     Triangulation<2>          tria;
     FESystem<2>               fe;
@@ -197,6 +220,13 @@ namespace tribo::fem
     SparsityPattern           sparsity;
     SparseMatrix<double>      M, K, Mt; // condensed: Z^T A Z on masters, a diagonal on constrained rows
     Vector<double>            f_unit;   // Z^T f for P = 1 Pa, N/m per Pa
+
+    // Reduced model (prm.reduced): M, K, Mt, f_unit, the state and node_z are in the
+    // coordinates q of T; constraints then has no lines. basis holds T (n_dofs x r,
+    // columns with the mesh's constraints distributed), boundary_dofs the dofs of u_b.
+    Eigen::MatrixXd                      basis;
+    std::vector<types::global_dof_index> boundary_dofs;
+    std::vector<double>                  omega;
 
     Vector<double> u, v, v_free, v_prev; // v_prev: velocity at the start of the last step
     Vector<double> rhs, tmp;
@@ -227,6 +257,18 @@ namespace tribo::fem
     void assemble(const AffineConstraints<double> &c, SparseMatrix<double> *mass, SparseMatrix<double> &stiffness,
                   Vector<double> &load) const;
     void find_boundary_nodes();
+    void reduce();
+    /// The mesh's dof vector of a model vector: T x (reduced) or x itself.
+    Vector<double> full(const Vector<double> &x) const
+    {
+      if (basis.size() == 0)
+        return x;
+      Vector<double>                      y(dof.n_dofs());
+      Eigen::Map<Eigen::VectorXd>         ye(y.data(), y.size());
+      Eigen::Map<const Eigen::VectorXd>   xe(x.data(), x.size());
+      ye.noalias() = basis * xe;
+      return y;
+    }
     void factorize();
     void solve(Vector<double> &b); // b := Mt^-1 b, then the constraints are distributed
 
@@ -287,60 +329,93 @@ namespace tribo::fem
     c.close();
   }
 
+  namespace
+  {
+    /// Per-thread work space of the assembly: the cell's and the top face's FEValues.
+    struct AssemblyScratch
+    {
+      AssemblyScratch(const FiniteElement<2> &fe, unsigned int degree)
+        : fv(fe, QGauss<2>(degree + 1), update_values | update_gradients | update_JxW_values)
+        , ffv(fe, QGauss<1>(degree + 1), update_values | update_JxW_values)
+      {}
+      AssemblyScratch(const AssemblyScratch &other)
+        : fv(other.fv.get_fe(), other.fv.get_quadrature(), other.fv.get_update_flags())
+        , ffv(other.ffv.get_fe(), other.ffv.get_quadrature(), other.ffv.get_update_flags())
+      {}
+      FEValues<2>     fv;
+      FEFaceValues<2> ffv;
+    };
+
+    /// One cell's mass, stiffness and unit-load contributions and its dofs.
+    struct AssemblyCopy
+    {
+      explicit AssemblyCopy(unsigned int nd)
+        : cm(nd, nd)
+        , ck(nd, nd)
+        , cf(nd)
+        , dofs(nd)
+      {}
+      FullMatrix<double>                   cm, ck;
+      Vector<double>                       cf;
+      std::vector<types::global_dof_index> dofs;
+    };
+  } // namespace
+
   void ElasticBody::Impl::assemble(const AffineConstraints<double> &c, SparseMatrix<double> *mass,
                                    SparseMatrix<double> &stiffness, Vector<double> &load) const
   {
-    const QGauss<2>     quad(prm.degree + 1);
-    const QGauss<1>     face_quad(prm.degree + 1);
-    FEValues<2>         fv(fe, quad, update_values | update_gradients | update_JxW_values);
-    FEFaceValues<2>     ffv(fe, face_quad, update_values | update_JxW_values);
-    const unsigned int  nd = fe.n_dofs_per_cell();
-    FullMatrix<double>  cm(nd, nd), ck(nd, nd);
-    Vector<double>      cf(nd);
-    std::vector<types::global_dof_index> dofs(nd);
     const FEValuesExtractors::Vector disp(0);
 
-    for (const auto &cell : dof.active_cell_iterators())
-      {
-        fv.reinit(cell);
-        cm = 0;
-        ck = 0;
-        cf = 0;
-        for (unsigned int q = 0; q < quad.size(); ++q)
+    // The cells are integrated concurrently (deal.II's WorkStream over TBB); the copier
+    // adds them to the global matrices one at a time, in cell order.
+    const auto integrate = [&](const DoFHandler<2>::active_cell_iterator &cell, AssemblyScratch &scratch,
+                               AssemblyCopy &copy) {
+      FEValues<2> &fv = scratch.fv;
+      fv.reinit(cell);
+      const unsigned int nd = copy.dofs.size();
+      copy.cm = 0;
+      copy.ck = 0;
+      copy.cf = 0;
+      for (unsigned int q = 0; q < fv.n_quadrature_points; ++q)
+        {
+          const double dx = fv.JxW(q);
+          for (unsigned int i = 0; i < nd; ++i)
+            {
+              const auto   phi_i = fv[disp].value(i, q);
+              const auto   eps_i = fv[disp].symmetric_gradient(i, q);
+              const double div_i = fv[disp].divergence(i, q);
+              for (unsigned int j = i; j < nd; ++j)
+                {
+                  copy.cm(i, j) += prm.density * (phi_i * fv[disp].value(j, q)) * dx;
+                  copy.ck(i, j) += (lambda * div_i * fv[disp].divergence(j, q) +
+                                    2 * mu * scalar_product(eps_i, fv[disp].symmetric_gradient(j, q))) * dx;
+                }
+            }
+        }
+      for (unsigned int i = 0; i < nd; ++i)
+        for (unsigned int j = 0; j < i; ++j)
           {
-            const double dx = fv.JxW(q);
-            for (unsigned int i = 0; i < nd; ++i)
-              {
-                const auto   phi_i = fv[disp].value(i, q);
-                const auto   eps_i = fv[disp].symmetric_gradient(i, q);
-                const double div_i = fv[disp].divergence(i, q);
-                for (unsigned int j = i; j < nd; ++j)
-                  {
-                    cm(i, j) += prm.density * (phi_i * fv[disp].value(j, q)) * dx;
-                    ck(i, j) += (lambda * div_i * fv[disp].divergence(j, q) +
-                                 2 * mu * scalar_product(eps_i, fv[disp].symmetric_gradient(j, q))) * dx;
-                  }
-              }
+            copy.cm(i, j) = copy.cm(j, i);
+            copy.ck(i, j) = copy.ck(j, i);
           }
-        for (unsigned int i = 0; i < nd; ++i)
-          for (unsigned int j = 0; j < i; ++j)
-            {
-              cm(i, j) = cm(j, i);
-              ck(i, j) = ck(j, i);
-            }
-        for (const auto f : cell->face_indices())
-          if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == top_id)
-            {
-              ffv.reinit(cell, f);
-              for (unsigned int q = 0; q < face_quad.size(); ++q)
-                for (unsigned int i = 0; i < nd; ++i) // traction (0, -1 Pa)
-                  cf(i) -= ffv[disp].value(i, q)[1] * ffv.JxW(q);
-            }
-        cell->get_dof_indices(dofs);
-        if (mass)
-          c.distribute_local_to_global(cm, dofs, *mass);
-        c.distribute_local_to_global(ck, cf, dofs, stiffness, load);
-      }
+      for (const auto f : cell->face_indices())
+        if (cell->face(f)->at_boundary() && cell->face(f)->boundary_id() == top_id)
+          {
+            FEFaceValues<2> &ffv = scratch.ffv;
+            ffv.reinit(cell, f);
+            for (unsigned int q = 0; q < ffv.n_quadrature_points; ++q)
+              for (unsigned int i = 0; i < nd; ++i) // traction (0, -1 Pa)
+                copy.cf(i) -= ffv[disp].value(i, q)[1] * ffv.JxW(q);
+          }
+      cell->get_dof_indices(copy.dofs);
+    };
+    const auto add = [&](const AssemblyCopy &copy) {
+      if (mass)
+        c.distribute_local_to_global(copy.cm, copy.dofs, *mass);
+      c.distribute_local_to_global(copy.ck, copy.cf, copy.dofs, stiffness, load);
+    };
+    WorkStream::run(dof.begin_active(), dof.end(), integrate, add, AssemblyScratch(fe, prm.degree),
+                    AssemblyCopy(fe.n_dofs_per_cell()));
   }
 
   void ElasticBody::Impl::find_boundary_nodes()
@@ -383,6 +458,165 @@ namespace tribo::fem
         }
   }
 
+  // Craig-Bampton: T = [I 0 0; Psi Phi X] on q = (u_b, eta, zeta) (elastic_body.h).
+  void ElasticBody::Impl::reduce()
+  {
+    const std::size_t  N  = dof.n_dofs();
+    const unsigned int nb = node_z.size();
+    boundary_dofs.resize(nb);
+    for (unsigned int j = 0; j < nb; ++j)
+      {
+        if (node_z[j].size() != 1 || node_z[j][0].second != 1.0)
+          throw RunError("ElasticBody: the reduced model needs each bottom node component to be one dof; "
+                         "component " + std::to_string(j % 2) + " of node " + std::to_string(j / 2) + " is not");
+        boundary_dofs[j] = node_z[j][0].first;
+      }
+
+    // K_ii, M_ii: the same assembly with the boundary held (u_b = 0).
+    AffineConstraints<double> held;
+    for (const auto d : boundary_dofs)
+      held.add_line(d);
+    held.close();
+    held.merge(constraints, AffineConstraints<double>::no_conflicts_allowed);
+    held.close();
+    DynamicSparsityPattern dsp(N);
+    DoFTools::make_sparsity_pattern(dof, dsp, held, false);
+    SparsityPattern held_sparsity;
+    held_sparsity.copy_from(dsp);
+    SparseMatrix<double> K_held(held_sparsity), M_held(held_sparsity);
+    Vector<double>       f_held(N);
+    assemble(held, &M_held, K_held, f_held);
+    const auto interior = make_direct_solver(prm.solver);
+    interior->factorize(K_held);
+    // x := K_ii^-1 x on the interior unknowns, 0 on the held ones.
+    const auto solve_interior = [&](Vector<double> &x) {
+      held.set_zero(x);
+      interior->solve(x.data(), 1);
+      held.set_zero(x);
+    };
+
+    const std::size_t n_interior = N - held.n_constraints();
+    if (prm.modes + 2 > n_interior)
+      throw InputError("ElasticBody: " + std::to_string(prm.modes) + " modes asked of a body with " +
+                       std::to_string(n_interior) + " interior unknowns: at most " +
+                       std::to_string(n_interior - 2));
+    const unsigned int k = prm.modes, r = nb + k + 1;
+    basis.setZero(N, r);
+    Vector<double> x(N), w(N);
+    const auto     store = [&](unsigned int column) {
+      constraints.distribute(x);
+      std::copy(x.begin(), x.end(), basis.col(column).data());
+    };
+
+    // Psi: u_i = -K_ii^-1 K_ib e_j for a unit displacement of boundary unknown j.
+    for (unsigned int j = 0; j < nb; ++j)
+      {
+        w                   = 0;
+        w[boundary_dofs[j]] = 1;
+        K.vmult(x, w);
+        x *= -1;
+        solve_interior(x);
+        x[boundary_dofs[j]] = 1;
+        store(j);
+      }
+
+    // Phi: the k lowest modes of K_ii phi = omega^2 M_ii phi, shift-invert about 0.
+    std::vector<Vector<double>> phi;
+    if (k > 0)
+      {
+        const ActionOperator inverse{[&](Vector<double> &dst, const Vector<double> &src) {
+          dst = src;
+          solve_interior(dst);
+        }};
+        const ActionOperator mass{[&](Vector<double> &dst, const Vector<double> &src) {
+          M_held.vmult(dst, src);
+          held.set_zero(dst);
+        }};
+        // Lanczos vectors: 2k + 2 (at least 20), at most the interior's dimension.
+        const unsigned int arnoldi = std::min<std::size_t>(n_interior, std::max(2 * k + 2, 20U));
+        SolverControl      control(10 * N, 1e-10);
+        ArpackSolver       arpack(control, ArpackSolver::AdditionalData(arnoldi, ArpackSolver::largest_magnitude, true));
+        std::vector<std::complex<double>> lambda(k);
+        phi.assign(k, Vector<double>(N));
+        arpack.solve(K_held, mass, inverse, lambda, phi, k);
+        std::vector<unsigned int> order(k);
+        for (unsigned int i = 0; i < k; ++i)
+          order[i] = i;
+        std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) { return lambda[a].real() < lambda[b].real(); });
+        omega.clear();
+        for (unsigned int i = 0; i < k; ++i)
+          {
+            x = phi[order[i]];
+            held.set_zero(x);
+            mass.vmult(w, x);
+            x /= std::sqrt(x * w); // M-orthonormal
+            omega.push_back(std::sqrt(lambda[order[i]].real()));
+            store(nb + i);
+          }
+      }
+
+    // X: the interior's static response to the unit top load, M-orthogonal to Phi.
+    x = f_unit;
+    solve_interior(x);
+    {
+      Eigen::Map<Eigen::VectorXd> xe(x.data(), N);
+      for (unsigned int i = 0; i < k; ++i)
+        {
+          Vector<double> p(N);
+          std::copy(basis.col(nb + i).data(), basis.col(nb + i).data() + N, p.begin());
+          held.set_zero(p);
+          M_held.vmult(w, p);
+          held.set_zero(w);
+          x.add(-(x * w), p);
+        }
+      M_held.vmult(w, x);
+      held.set_zero(w);
+      const double norm = std::sqrt(x * w);
+      if (norm > 0)
+        xe /= norm;
+    }
+    store(nb + k);
+
+    // T^T M T, T^T K T, T^T f, with the mesh's (condensed) matrices.
+    const auto project = [&](const SparseMatrix<double> &A) {
+      Eigen::MatrixXd AT(N, r);
+      for (unsigned int c = 0; c < r; ++c)
+        {
+          std::copy(basis.col(c).data(), basis.col(c).data() + N, x.begin());
+          vmult_free(A, x, w);
+          std::copy(w.begin(), w.end(), AT.col(c).data());
+        }
+      Eigen::MatrixXd P = basis.transpose() * AT;
+      return Eigen::MatrixXd(0.5 * (P + P.transpose()));
+    };
+    const Eigen::MatrixXd M_r = project(M), K_r = project(K);
+    Eigen::Map<const Eigen::VectorXd> f(f_unit.data(), N);
+    const Eigen::VectorXd             f_r = basis.transpose() * f;
+
+    // The model is now q: dense r x r matrices in deal.II's sparse format (CHOLMOD
+    // factorises them as before), boundary unknowns first, no constraints.
+    DynamicSparsityPattern full_pattern(r, r);
+    for (unsigned int i = 0; i < r; ++i)
+      for (unsigned int j = 0; j < r; ++j)
+        full_pattern.add(i, j);
+    sparsity.copy_from(full_pattern);
+    M.reinit(sparsity);
+    K.reinit(sparsity);
+    Mt.reinit(sparsity);
+    for (unsigned int i = 0; i < r; ++i)
+      for (unsigned int j = 0; j < r; ++j)
+        {
+          M.set(i, j, M_r(i, j));
+          K.set(i, j, K_r(i, j));
+        }
+    f_unit.reinit(r);
+    std::copy(f_r.data(), f_r.data() + r, f_unit.begin());
+    for (unsigned int j = 0; j < nb; ++j)
+      node_z[j] = {{j, 1.0}};
+    constraints.clear();
+    constraints.close();
+  }
+
   void ElasticBody::Impl::factorize()
   {
     const double th = prm.theta;
@@ -390,12 +624,7 @@ namespace tribo::fem
     Mt *= 1 + th * h * prm.rayleigh_mass;
     Mt.add(th * h * prm.rayleigh_stiffness + th * th * h * h, K);
     if (!solver)
-      {
-        if (prm.solver == "cholmod")
-          solver = std::make_unique<CholmodSolver>();
-        else
-          solver = std::make_unique<UmfpackSolver>();
-      }
+      solver = make_direct_solver(prm.solver);
     solver->factorize(Mt);
     compliance_valid = false;
   }
@@ -423,10 +652,14 @@ namespace tribo::fem
     m.K.reinit(m.sparsity);
     m.Mt.reinit(m.sparsity);
     m.f_unit.reinit(m.dof.n_dofs());
+    const auto start = std::chrono::steady_clock::now();
     m.assemble(m.constraints, &m.M, m.K, m.f_unit);
+    m.assembly_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (m.prm.reduced)
+      m.reduce();
 
     for (auto *x : {&m.u, &m.v, &m.v_free, &m.v_prev, &m.rhs, &m.tmp})
-      x->reinit(m.dof.n_dofs());
+      x->reinit(m.M.m());
     m.factorize();
   }
 
@@ -436,7 +669,10 @@ namespace tribo::fem
 
   const ElasticBodyParameters &ElasticBody::parameters() const { return impl->prm; }
   unsigned int ElasticBody::n_dofs() const { return impl->dof.n_dofs(); }
+  unsigned int ElasticBody::n_model_dofs() const { return impl->M.m(); }
+  const std::vector<double> &ElasticBody::mode_frequencies() const { return impl->omega; }
   double ElasticBody::lame_lambda() const { return impl->lambda; }
+  double ElasticBody::assembly_seconds() const { return impl->assembly_seconds; }
   double ElasticBody::shear_modulus() const { return impl->mu; }
   double ElasticBody::time() const { return impl->t; }
   double ElasticBody::time_step() const { return impl->h; }
@@ -570,7 +806,7 @@ namespace tribo::fem
     if (m.compliance_valid)
       return m.compliance;
     const unsigned int  nc = m.node_z.size(), block = 32;
-    const std::size_t   N  = m.dof.n_dofs();
+    const std::size_t   N  = m.M.m();
     std::vector<double> B(N * block);
     m.compliance.resize(nc, nc);
     for (unsigned int start = 0; start < nc; start += block)
@@ -614,21 +850,21 @@ namespace tribo::fem
   Eigen::Vector2d ElasticBody::displacement_at(const Eigen::Vector2d &x) const
   {
     Vector<double> value(2);
-    VectorTools::point_value(impl->dof, impl->u, Point<2>(x[0], x[1]), value);
+    VectorTools::point_value(impl->dof, impl->full(impl->u), Point<2>(x[0], x[1]), value);
     return {value[0], value[1]};
   }
 
   Eigen::Vector2d ElasticBody::velocity_at(const Eigen::Vector2d &x) const
   {
     Vector<double> value(2);
-    VectorTools::point_value(impl->dof, impl->v, Point<2>(x[0], x[1]), value);
+    VectorTools::point_value(impl->dof, impl->full(impl->v), Point<2>(x[0], x[1]), value);
     return {value[0], value[1]};
   }
 
   Eigen::Matrix2d ElasticBody::strain_at(const Eigen::Vector2d &x) const
   {
     std::vector<Tensor<1, 2>> grad(2);
-    VectorTools::point_gradient(impl->dof, impl->u, Point<2>(x[0], x[1]), grad);
+    VectorTools::point_gradient(impl->dof, impl->full(impl->u), Point<2>(x[0], x[1]), grad);
     Eigen::Matrix2d eps;
     for (unsigned int a = 0; a < 2; ++a)
       for (unsigned int b = 0; b < 2; ++b)
@@ -653,7 +889,21 @@ namespace tribo::fem
     direct.initialize(Ks);
     direct.solve(f);
     c.distribute(f);
-    m.u         = f;
+    if (m.basis.size() == 0)
+      m.u = f;
+    else
+      {
+        // q_b is u at the boundary dofs; the rest is the least-squares fit of the
+        // remainder by the other columns of T, exact when it lies in their span.
+        const unsigned int nb = m.boundary_dofs.size(), r = m.basis.cols();
+        Eigen::Map<const Eigen::VectorXd> fe(f.data(), f.size());
+        Eigen::VectorXd                   q(r);
+        for (unsigned int j = 0; j < nb; ++j)
+          q[j] = f[m.boundary_dofs[j]];
+        const Eigen::VectorXd rest = fe - m.basis.leftCols(nb) * q.head(nb);
+        q.tail(r - nb)             = m.basis.rightCols(r - nb).colPivHouseholderQr().solve(rest);
+        std::copy(q.data(), q.data() + r, m.u.begin());
+      }
     m.v         = 0;
     m.predicted = false;
   }
@@ -682,7 +932,8 @@ namespace tribo::fem
 
   void ElasticBody::write_vtu(const std::string &filename) const
   {
-    const Impl &m = *impl;
+    const Impl          &m = *impl;
+    const Vector<double> u = m.full(m.u), v = m.full(m.v);
     const double nu = m.prm.poisson_ratio;
     const unsigned int nc = m.tria.n_active_cells();
     Vector<double> sxx(nc), syy(nc), sxy(nc), szz(nc), mises(nc);
@@ -693,7 +944,7 @@ namespace tribo::fem
     for (const auto &cell : m.dof.active_cell_iterators())
       {
         fv.reinit(cell);
-        fv[disp].get_function_symmetric_gradients(m.u, eps);
+        fv[disp].get_function_symmetric_gradients(u, eps);
         double area = 0, exx = 0, eyy = 0, exy = 0;
         for (unsigned int q = 0; q < quad.size(); ++q)
           {
@@ -716,8 +967,8 @@ namespace tribo::fem
     out.attach_dof_handler(m.dof);
     const std::vector<DataComponentInterpretation::DataComponentInterpretation> vector_field(
       2, DataComponentInterpretation::component_is_part_of_vector);
-    out.add_data_vector(m.u, std::vector<std::string>(2, "displacement"), DataOut<2>::type_dof_data, vector_field);
-    out.add_data_vector(m.v, std::vector<std::string>(2, "velocity"), DataOut<2>::type_dof_data, vector_field);
+    out.add_data_vector(u, std::vector<std::string>(2, "displacement"), DataOut<2>::type_dof_data, vector_field);
+    out.add_data_vector(v, std::vector<std::string>(2, "velocity"), DataOut<2>::type_dof_data, vector_field);
     out.add_data_vector(sxx, "sigma_xx", DataOut<2>::type_cell_data);
     out.add_data_vector(syy, "sigma_yy", DataOut<2>::type_cell_data);
     out.add_data_vector(sxy, "sigma_xy", DataOut<2>::type_cell_data);

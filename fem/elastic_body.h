@@ -78,6 +78,19 @@ namespace tribo::fem
     /// Direct solver for Mt: "cholmod" (SuiteSparse CHOLMOD, Cholesky, the faster one
     /// here, docs/fem.md) or "umfpack" (deal.II's SparseDirectUMFPACK, LU).
     std::string solver = "cholmod";
+
+    /// Craig-Bampton reduction of the body onto its bottom contact nodes: u = T q with
+    /// q = (u_b, eta, zeta) and T = [I 0 0; Psi Phi X]: the 2n constraint modes
+    /// Psi = -K_ii^-1 K_ib (static shapes of unit boundary displacements), the @p modes
+    /// lowest fixed-interface modes Phi (K_ii phi = omega^2 M_ii phi, boundary fixed,
+    /// M-orthonormal, by ARPACK in shift-invert mode through deal.II) and one load mode
+    /// X = K_ii^-1 f_i (the interior's static response to the top pressure with the
+    /// boundary fixed, M-orthogonal to Phi). M, K and f become T^T M T, T^T K T, T^T f
+    /// and the theta scheme runs on q (2n + modes + 1 unknowns): exact in the static
+    /// limit (Guyan condensation plus the load mode), an approximation of the dynamics
+    /// above the highest kept mode. Fields are rebuilt as T q for output.
+    bool         reduced = false;
+    unsigned int modes   = 20;
   };
 
   /// The deformable first body. Protocol of one step of size h:
@@ -100,11 +113,20 @@ namespace tribo::fem
     ElasticBody &operator=(ElasticBody &&) noexcept;
 
     const ElasticBodyParameters &parameters() const;
-    unsigned int n_dofs() const;   ///< number of dofs, constrained ones included
+    unsigned int n_dofs() const;   ///< number of dofs of the mesh, constrained ones included
+    /// Unknowns of the time integration: n_dofs() for the full model, 2n + modes + 1
+    /// for the reduced one.
+    unsigned int n_model_dofs() const;
+    /// Reduced model: the angular frequencies omega (rad/s) of the kept fixed-interface
+    /// modes, increasing; empty for the full model.
+    const std::vector<double> &mode_frequencies() const;
     double lame_lambda() const;    ///< lambda (Pa)
     double shear_modulus() const;  ///< mu (Pa)
     double time() const;           ///< t (s) at the start of the next step
     double time_step() const;      ///< h (s)
+    /// Wall time of the constructor's assembly of M, K and the unit load (cells
+    /// integrated concurrently through deal.II's WorkStream), s.
+    double assembly_seconds() const;
     double pressure(double t) const; ///< P(t) (Pa), ramp included
 
     /// Change h (s); only if h changes: refactorises Mt, drops the cached compliance and
@@ -168,7 +190,8 @@ namespace tribo::fem
     /// Static equilibrium K u = f for the full pressure P, with the step's
     /// constraints plus u_y = 0 on the bottom face (a roller, which removes the rigid
     /// y-translation) and, if the top is free in x, u_x = 0 at node 0. Sets u to it
-    /// and v = 0 (time unchanged). For tests and initial states.
+    /// and v = 0 (time unchanged); the reduced model takes the M-orthogonal projection
+    /// of the full solution onto T, which holds it exactly. For tests and initial states.
     void static_solve();
 
     /// Write displacement, velocity (point data) and per-cell averages of sigma_xx,

@@ -10,8 +10,13 @@ test_shear_physics.py (120 discs, 13 us of shear, tolerance 1e-3):
   sigma_yy profile is flat at P away from the first bodies;
 - the stiff limit: a body 1e6 times stiffer than steel, with half-discs as large as the
   rigid wall's discs (the same roughness), gives the rigid wall's friction and a
-  velocity profile that ends near 0 at the upper body, as the rigid wall does;
-- the VTU of the body: its mean sigma_yy over the snapshots after landing is near -P.
+  velocity profile that ends near 0 at the upper body, as the rigid wall does. A cell of
+  120 discs has states where the layer slips along the upper body (1 of 12 stiff-body
+  realizations with 4 NLGS streams, seed 1), so this is asserted on three realizations
+  (disc-size seeds 1-3): their mean friction, and the median profile;
+- the VTU of the body: its mean sigma_yy over the snapshots after landing is near -P;
+- the reduced (Craig-Bampton) body keeps the energy balance of every step and the
+  equilibrium, and costs less per step than the full body.
 
 Usage: test_shear_fem.py PATH/TO/tribo
 """
@@ -35,6 +40,7 @@ TRIBO = None
 P, L, V, H = base.P, base.L, base.V, 2e-9
 COMMON = ["--set", "Solver/Tolerance=1e-3"]
 FEM = ["--set", "Shear cell/Upper body model=fem"]
+SEEDS = (1, 2, 3)
 
 
 def run(directory, name, extra):
@@ -58,18 +64,28 @@ class DeformableUpperBody(unittest.TestCase):
         cls.tmp = tempfile.TemporaryDirectory()
         with concurrent.futures.ThreadPoolExecutor(2) as pool:
             steel = pool.submit(run, cls.tmp.name, "steel", FEM + ["--set", "Output/Field interval=1000"])
-            stiff = pool.submit(run, cls.tmp.name, "stiff",
-                                FEM + ["--set", "Shear cell/Upper body Young's modulus=1e17",
-                                       "--set", "Shear cell/Half-disc diameter=1.2e-6"])
-            rigid = pool.submit(run, cls.tmp.name, "rigid", [])
-            cls.steel, cls.stiff, cls.rigid = steel.result(), stiff.result(), rigid.result()
+            reduced = pool.submit(run, cls.tmp.name, "reduced", ["--set", "Shear cell/Upper body model=reduced"])
+            stiff, rigid = [], []
+            for seed in SEEDS:
+                s = ["--set", f"Shear cell/Seed={seed}"]
+                stiff.append(pool.submit(run, cls.tmp.name, f"stiff_{seed}",
+                                         FEM + s + ["--set", "Shear cell/Upper body Young's modulus=1e17",
+                                                    "--set", "Shear cell/Half-disc diameter=1.2e-6"]))
+                rigid.append(pool.submit(run, cls.tmp.name, f"rigid_{seed}", s))
+            cls.steel, cls.reduced = steel.result(), reduced.result()
+            cls.stiffs, cls.rigids = [f.result() for f in stiff], [f.result() for f in rigid]
+            cls.stiff, cls.rigid = cls.stiffs[0], cls.rigids[0]
 
     @classmethod
     def tearDownClass(cls):
         cls.tmp.cleanup()
 
     def test_energy_balance_every_step(self):
-        _, r, st, _ = self.steel
+        for out in (self.steel, self.reduced):
+            with self.subTest(out[0]):
+                self.check_energy_balance(*out)
+
+    def check_energy_balance(self, _, r, st, p):
         energy = st["kinetic_energy"] + st["kinetic_energy_upper_wall"] + st["elastic_energy_upper_body"]
         self.assertGreater(st["elastic_energy_upper_body"].max(), 0)
         change = np.diff(energy)
@@ -84,19 +100,26 @@ class DeformableUpperBody(unittest.TestCase):
         self.assertGreater(np.abs(change[~keep]).max(), 1e-6 * np.abs(energy).max())  # the jump is real
 
     def test_equilibrium(self):
-        for out, r, st, p in (self.steel, self.stiff):
+        for out, r, st, p in (self.steel, self.stiff, self.reduced):
             self.assertAlmostEqual(r["normal_force_mean"] / (P * L), 1.0, delta=0.01)
             interior = p["sigma_yy"][2:-2]
             np.testing.assert_allclose(interior, P, rtol=0.03)
             self.assertAlmostEqual(r["power_balance_ratio"], 1.0, delta=0.05)
 
     def test_stiff_body_reproduces_the_rigid_wall(self):
-        _, rs, _, ps = self.stiff
-        _, rr, _, pr = self.rigid
-        self.assertAlmostEqual(rs["mu_mean"] / rr["mu_mean"], 1.0, delta=0.15)
-        for p in (ps, pr):
-            self.assertGreater(p["vx"][0], 0.7 * V)
-            self.assertLess(p["vx"][-1], 0.3 * V)
+        mu = {name: np.mean([r["mu_mean"] for _, r, _, _ in runs])
+              for name, runs in (("stiff", self.stiffs), ("rigid", self.rigids))}
+        self.assertAlmostEqual(mu["stiff"] / mu["rigid"], 1.0, delta=0.1)
+        for runs in (self.stiffs, self.rigids):
+            self.assertGreater(np.median([p["vx"][0] for _, _, _, p in runs]), 0.7 * V)
+            self.assertLess(np.median([p["vx"][-1] for _, _, _, p in runs]), 0.3 * V)
+
+    def test_reduced_body_is_cheaper(self):
+        timing = {name: json.load(open(os.path.join(out[0], "summary.json")))["timing"]["boundary_body_mean_s"]
+                  for name, out in (("fem", self.steel), ("reduced", self.reduced))}
+        self.assertLess(timing["reduced"], 0.2 * timing["fem"])
+        with open(os.path.join(self.reduced[0], "log.txt")) as f:
+            self.assertRegex(f.read(), r"reduced upper body: .* reduced to 47 \(26 boundary, 20 modes")
 
     def test_only_what_the_case_needs_is_built(self):
         """The rigid wall builds no deal.II body: its set-up takes less memory (the

@@ -1,4 +1,5 @@
-// Cell-list detection against brute force, with and without x-periodicity.
+// Cell-list detection against brute force, with and without x-periodicity, and the
+// threaded search against the serial one.
 #include "dem/contact.h"
 
 #include <gtest/gtest.h>
@@ -28,7 +29,7 @@ namespace
     return pairs;
   }
 
-  void compare(double period)
+  ParticleSystem random_discs(double period)
   {
     ParticleSystem s;
     s.period = period;
@@ -36,7 +37,13 @@ namespace
     std::uniform_real_distribution<double> ux(0, 20e-6), uy(0, 8e-6), ur(0.4e-6, 0.6e-6);
     for (int i = 0; i < 300; ++i)
       s.add_disc({ux(rng), uy(rng)}, ur(rng), 7800);
-    std::vector<Vec2> x;
+    return s;
+  }
+
+  void compare(double period)
+  {
+    const ParticleSystem s = random_discs(period);
+    std::vector<Vec2>    x;
     for (unsigned d = 0; d < s.discs.size(); ++d)
       x.push_back(s.wrap(s.disc_centre(d)));
     ContactDetector detector;
@@ -57,3 +64,27 @@ namespace
 TEST(Detection, CellListFindsTheBruteForcePairs) { compare(0); }
 
 TEST(Detection, CellListFindsPairsAcrossThePeriodicBoundary) { compare(20e-6); }
+
+// Rows of cells searched in 4 T chunks concurrently and joined in order: the same
+// contacts in the same order, bit for bit, as the serial pass.
+TEST(Detection, ThreadedSearchIsTheSerialSearch)
+{
+  const ParticleSystem s = random_discs(20e-6);
+  std::vector<Vec2>    x;
+  for (unsigned d = 0; d < s.discs.size(); ++d)
+    x.push_back(s.wrap(s.disc_centre(d)));
+  ContactDetector detector;
+  const auto      serial = detector.detect(s, x, 1e-7, 1);
+  ASSERT_GT(serial.size(), 100u);
+  for (unsigned int threads : {2u, 3u, 8u})
+    {
+      const auto threaded = detector.detect(s, x, 1e-7, threads);
+      ASSERT_EQ(threaded.size(), serial.size()) << threads << " threads";
+      for (std::size_t k = 0; k < serial.size(); ++k)
+        {
+          EXPECT_EQ(threaded[k].disc[0], serial[k].disc[0]) << "contact " << k << ", " << threads << " threads";
+          EXPECT_EQ(threaded[k].disc[1], serial[k].disc[1]) << "contact " << k << ", " << threads << " threads";
+          EXPECT_EQ(threaded[k].gap, serial[k].gap);
+        }
+    }
+}
