@@ -122,5 +122,27 @@ int main(int argc, char **argv)
   std::printf("NLGS: %u sweeps over %zu contacts in %.3f s: %.3g contact updates per second "
               "(%.1f ns per update)\n",
               rep.iterations, frozen.size(), elapsed, updates / elapsed, 1e9 * elapsed / updates);
+
+  // The same sweeps in 1, 2, 4 and 8 interleaved streams (Solver/Streams), each from
+  // the converged impulses, three rounds in turn: the least cost per update of each
+  // (single timings on this shared machine scatter by up to 30 %).
+  const std::vector<unsigned int> stream_counts = {1, 2, 4, 8};
+  std::vector<double>             best(stream_counts.size(), 1e300);
+  for (unsigned int round = 0; round < 3; ++round)
+    for (std::size_t k = 0; k < stream_counts.size(); ++k)
+      {
+        std::vector<dem::Contact> copy = mj.contacts();
+        dem::BodyState            s    = dem::BodyState::of(system);
+        fixed.streams                  = stream_counts[k];
+        dem::NlgsSolver sweeper(fixed);
+        t0                   = Clock::now();
+        const auto   r       = sweeper.solve(copy, s, mj.law());
+        const double seconds = seconds_since(t0);
+        best[k] = std::min(best[k], 1e9 * seconds / (double(r.iterations + r.check_passes) * copy.size()));
+      }
+  std::printf("streams (least of 3):");
+  for (std::size_t k = 0; k < stream_counts.size(); ++k)
+    std::printf(" %u: %.1f ns", stream_counts[k], best[k]);
+  std::printf(" per update\n");
   return 0;
 }

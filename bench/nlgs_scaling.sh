@@ -33,5 +33,6 @@ print("%8s %9.0f %12.1f %10.2f %10.1f %12.1f %12.1f %14.0f" % (
     n, grab(r"sweeps over (\d+) contacts"), grab(r"\(([\d.]+) ns per update\)"),
     1e3 * grab(r": ([\d.]+) s per step"), grab(r"s per step, ([\d.]+) sweeps"),
     grab(r"per disc: detection ([\d.]+) ns"), grab(r"rest ([\d.]+) ns"), grab(r"memory: (\d+) bytes")))
+print("         " + re.search(r"streams .*", out).group(0))
 PY
 done

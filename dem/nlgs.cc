@@ -195,14 +195,20 @@ namespace tribo::dem
     if (prm.order == NlgsParameters::Order::fixed && prm.streams > 1)
       for (unsigned int k = 0; k < n_bands; ++k)
         {
-          // Band k's contacts in streams of `chunk`, one from each stream in turn.
-          const unsigned int size = begin[k + 1] - begin[k], streams = prm.streams;
-          const unsigned int chunk = (size + streams - 1) / streams;
-          unsigned int       i     = begin[k];
-          for (unsigned int j = 0; j < chunk; ++j)
-            for (unsigned int s = 0; s < streams; ++s)
-              if (s * chunk + j < size)
-                order[i++] = begin[k] + s * chunk + j;
+          // Band k in windows of streams x spacing contacts; a window's contacts in
+          // streams of `chunk` (spacing, or less in the band's last window), one from each
+          // stream in turn.
+          const unsigned int streams = prm.streams, window = streams * std::max(1U, prm.stream_spacing);
+          unsigned int       i       = begin[k];
+          for (unsigned int start = begin[k]; start < begin[k + 1]; start += window)
+            {
+              const unsigned int size  = std::min(window, begin[k + 1] - start);
+              const unsigned int chunk = (size + streams - 1) / streams;
+              for (unsigned int j = 0; j < chunk; ++j)
+                for (unsigned int s = 0; s < streams; ++s)
+                  if (s * chunk + j < size)
+                    order[i++] = start + s * chunk + j;
+            }
         }
 
     auto solve_band = [&](unsigned int k) {

@@ -140,23 +140,30 @@ TEST(NlgsBands, RunKeepsTheEnergyBalanceOfEveryStep)
 
 TEST(NlgsBands, StreamsAreTheSerialSweepInInterleavedOrder)
 {
-  // Streams = 4: contacts 0, q, 2q, 3q, 1, q + 1, ... (q = n / 4 rounded up): the same
-  // sweep as the detection-order solver run on the contacts listed in that order.
+  // Streams = 4, spacing 16: in each window of 64 contacts starting at w, contacts w,
+  // w + q, w + 2q, w + 3q, w + 1, ... (q = 16, or the last window's size / 4 rounded up):
+  // the same sweep as the detection-order solver run on the contacts in that order.
   const ColdStart             cold;
   const ParticleSystem       &s        = cold.system;
   const std::vector<Contact> &contacts = cold.contacts;
   NlgsParameters              fixed    = fixed_sweeps(40);
   fixed.streams                        = 4;
+  fixed.stream_spacing                 = 16;
   std::vector<Contact> streamed = contacts;
   BodyState            streamed_state = BodyState::of(s);
   NlgsSolver(fixed).solve(streamed, streamed_state, cold.law);
 
-  const std::size_t        n = contacts.size(), q = (n + 3) / 4;
+  const std::size_t        n = contacts.size();
+  ASSERT_GT(n, 3 * 64u); // several windows, the last one partial unless n % 64 = 0
   std::vector<std::size_t> order;
-  for (std::size_t j = 0; j < q; ++j)
-    for (std::size_t k = 0; k < 4; ++k)
-      if (k * q + j < n)
-        order.push_back(k * q + j);
+  for (std::size_t w = 0; w < n; w += 64)
+    {
+      const std::size_t size = std::min<std::size_t>(64, n - w), q = (size + 3) / 4;
+      for (std::size_t j = 0; j < q; ++j)
+        for (std::size_t k = 0; k < 4; ++k)
+          if (k * q + j < size)
+            order.push_back(w + k * q + j);
+    }
   ASSERT_EQ(order.size(), n);
   std::vector<Contact> serial;
   for (const std::size_t a : order)
