@@ -3,7 +3,9 @@
 /// time loop of run_case(): each runs its own loop and writes the same kind of outputs
 /// (statistics.csv, summary.json, results.h5, fields/ with a .pvd index, log.txt).
 /// run_case() has prepared the output directory, written original.prm, parameters.prm
-/// and a "running" summary.json, and opened the log, before it hands over.
+/// and a "running" summary.json, opened the log, and for --resume checked the checkpoint's
+/// parameters against the case, before it hands over. Each loop writes its checkpoints and
+/// resumes from one through the RunCheckpoint it is given (app/run.h), as run_case() does.
 
 #include "app/run.h"
 #include "core/output.h"
@@ -27,7 +29,8 @@ namespace tribo::app
   /// entry otherwise): `tribo check`, and `tribo run` before it writes anything.
   void check_sph_scene(const ParameterFile &file);
   /// Run an SPH scene into @p dir; returns the exit code (as run_case()).
-  int run_sph_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o);
+  int run_sph_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o,
+                    RunCheckpoint &checkpoint);
 #endif
 
 #ifdef TRIBO_WITH_MLP_SCENES
@@ -38,6 +41,7 @@ namespace tribo::app
   /// writes anything.
   void check_mlp_scene(const ParameterFile &file);
   /// Run an MLP scene into @p dir; returns the exit code (as run_case()).
-  int run_mlp_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o);
+  int run_mlp_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o,
+                    RunCheckpoint &checkpoint);
 #endif
 } // namespace tribo::app

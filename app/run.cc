@@ -8,13 +8,10 @@
 #include "core/output.h"
 #include "core/parameter_file.h"
 #include "core/run_control.h"
+#include "core/serialization.h"
 
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
-#include <boost/archive/binary_iarchive.hpp>
-#include <boost/archive/binary_oarchive.hpp>
-#include <boost/serialization/map.hpp>
-#include <boost/serialization/string.hpp>
 
 #include <cctype>
 #include <cstdlib>
@@ -155,6 +152,52 @@ namespace tribo::app
            (defaulted.empty() ? "" : "; not in the checkpoint, at their defaults: " + defaulted);
   }
 
+  RunCheckpoint::RunCheckpoint(const std::string &dir, std::map<std::string, std::string> resolved,
+                               double interval, unsigned long step_interval, bool resuming,
+                               std::string changes)
+    : path((fs::path(dir) / "checkpoint.bin").string())
+    , parameters(std::move(resolved))
+    , interval(interval)
+    , step_interval(step_interval)
+    , resume(resuming)
+    , changes(std::move(changes))
+    , start(Clock::now())
+    , last(start)
+  {}
+
+  bool RunCheckpoint::due(unsigned long step) const
+  {
+    const bool timer = interval > 0 && std::chrono::duration<double>(Clock::now() - last).count() > interval;
+    return timer || (step_interval > 0 && step % step_interval == 0);
+  }
+
+  void RunCheckpoint::write(const std::function<void(CheckpointOut &)> &save)
+  {
+    const double wall = wall_time();
+    write_checkpoint(path, [&](CheckpointOut &ar) {
+      ar << parameters << wall;
+      save(ar);
+    });
+    last = Clock::now();
+  }
+
+  void RunCheckpoint::read(Log &log, const std::function<void(CheckpointIn &)> &load)
+  {
+    read_checkpoint(path, [&](CheckpointIn &ar) {
+      std::map<std::string, std::string> saved; // checked by run_case() already
+      ar >> saved >> wall_before;
+      log("resuming from " + path + changes);
+      load(ar);
+    });
+  }
+
+  double RunCheckpoint::wall_time() const
+  {
+    return wall_before + std::chrono::duration<double>(Clock::now() - start).count();
+  }
+
+  void RunCheckpoint::remove() const { fs::remove(path); }
+
   bool is_sph_scene(const std::string &scene) { return scene.rfind("sph_", 0) == 0; }
   bool is_mlp_scene(const std::string &scene) { return scene.rfind("mlp_", 0) == 0; }
 
@@ -293,14 +336,16 @@ namespace tribo::app
     log.open((dir / "log.txt").string(), !o.quiet);
     log("tribo run " + o.case_file + " -> " + dir.string());
 
+    RunCheckpoint checkpoint(dir.string(), resolved, p.checkpoint_interval, p.checkpoint_step_interval,
+                             resuming, changes);
     // The explicit particle modules run their own time loop (app/particle_scenes.h).
 #ifdef TRIBO_WITH_SPH_SCENES
     if (is_sph_scene(p.scene))
-      return run_sph_scene(file, dir.string(), log, o);
+      return run_sph_scene(file, dir.string(), log, o, checkpoint);
 #endif
 #ifdef TRIBO_WITH_MLP_SCENES
     if (is_mlp_scene(p.scene))
-      return run_mlp_scene(file, dir.string(), log, o);
+      return run_mlp_scene(file, dir.string(), log, o, checkpoint);
 #endif
 
     install_stop_handlers();
@@ -343,16 +388,13 @@ namespace tribo::app
     std::string   status = "complete", failure;
     unsigned long step = 0, total_iterations = 0, non_converged = 0, max_iterations = 0;
     double        worst_overlap = 0, t = 0, max_residual = 0;
-    double        wall_before = 0; ///< wall time of the run before its last resumption, s
     StepTiming    timing;          ///< the steps since the start or the last resumption
 
-    // A checkpoint holds the resolved parameters, the loop's counters and every object's
-    // state, in this order (core/checkpoint.h).
+    // After the header (RunCheckpoint), the loop's counters and every object's state, in
+    // this order (core/checkpoint.h).
     const auto save_checkpoint = [&]() {
-      const double wall = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-      write_checkpoint(checkpoint_file.string(), [&](CheckpointOut &ar) {
-        ar << resolved << step << total_iterations << non_converged << max_iterations
-           << worst_overlap << max_residual << wall;
+      checkpoint.write([&](CheckpointOut &ar) {
+        ar << step << total_iterations << non_converged << max_iterations << worst_overlap << max_residual;
         system.save(ar);
         mj.save(ar);
         scene->save(ar);
@@ -362,12 +404,8 @@ namespace tribo::app
     };
     if (resuming)
       {
-        read_checkpoint(checkpoint_file.string(), [&](CheckpointIn &ar) {
-          std::map<std::string, std::string> saved;
-          ar >> saved;
-          log("resuming from " + checkpoint_file.string() + changes);
-          ar >> step >> total_iterations >> non_converged >> max_iterations >> worst_overlap >>
-            max_residual >> wall_before;
+        checkpoint.read(log, [&](CheckpointIn &ar) {
+          ar >> step >> total_iterations >> non_converged >> max_iterations >> worst_overlap >> max_residual;
           system.load(ar);
           mj.load(ar);
           scene->load(ar);
@@ -383,7 +421,7 @@ namespace tribo::app
       write_fields(fields, 0, system, mj, h, *scene);
 
     ProgressLine  progress(n_steps * h, !o.quiet);
-    auto          last_flush = std::chrono::steady_clock::now(), last_checkpoint = last_flush;
+    auto          last_flush = std::chrono::steady_clock::now();
     std::vector<double> last_row;
     try
       {
@@ -431,14 +469,8 @@ namespace tribo::app
                 atomic_write((dir / "statistics.csv").string(), stats.to_csv());
                 last_flush = now;
               }
-            const bool timer = p.checkpoint_interval > 0 &&
-                               std::chrono::duration<double>(now - last_checkpoint).count() > p.checkpoint_interval;
-            const bool every = p.checkpoint_step_interval > 0 && step % p.checkpoint_step_interval == 0;
-            if (stopping || ((timer || every) && !last))
-              {
-                save_checkpoint();
-                last_checkpoint = std::chrono::steady_clock::now();
-              }
+            if (stopping || (!last && checkpoint.due(step)))
+              save_checkpoint();
             progress.update(t, step);
             if (stopping)
               {
@@ -460,7 +492,7 @@ namespace tribo::app
     progress.finish();
     write_fields(fields, t, system, mj, h, *scene);
 
-    const double wall = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double wall = checkpoint.wall_time();
     summary.set("status", status);
     if (!failure.empty())
       summary.set("error", failure);
@@ -501,7 +533,7 @@ namespace tribo::app
     write_results_h5((dir / "results.h5").string(), stats, tables, resolved, scalars);
     atomic_write((dir / "summary.json").string(), summary.to_string());
     if (status == "complete")
-      fs::remove(checkpoint_file);
+      checkpoint.remove();
 
     if (p.plots && p.scene == "shear" && status != "failed" && !stats.rows().empty())
       {

@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "core/output.h"
 #include "core/run_control.h"
+#include "core/serialization.h"
 #include "mlp/analysis.h"
 #include "mlp/interaction.h"
 #include "mlp/langevin.h"
@@ -205,58 +206,40 @@ namespace tribo::app
       return p.size() ? 2.0 * bonds / p.size() : 0.0;
     }
 
-    /// VTU snapshots of the particles (one vertex per particle) with their .pvd index,
-    /// through deal.II's DataOutBase as core/field_writer.cc does for discs.
-    class ParticleWriter
+    /// Writes the snapshot fields/particles_NNNNN.vtu at time @p t (s), one vertex per
+    /// particle with point data velocity (m/s), group, force magnitude |F| (N/m), net and
+    /// bond-mean |F_return| (N/m), and adds it to the index particles.pvd of @p fields.
+    void write_particles(FieldWriter &fields, double t, const Particles &p,
+                         const std::vector<double> &ret_net, const std::vector<double> &ret_bond)
     {
-    public:
-      /// Writes into the existing directory @p directory (the run's fields/).
-      explicit ParticleWriter(std::string directory) : dir(std::move(directory)) {}
-
-      /// Writes particles_NNNNN.vtu at time @p t (s) with point data velocity (m/s),
-      /// group, force magnitude |F| (N/m), net and bond-mean |F_return| (N/m), and
-      /// rewrites particles.pvd.
-      void write(double t, const Particles &p, const std::vector<double> &ret_net,
-                 const std::vector<double> &ret_bond)
-      {
-        std::vector<dealii::DataOutBase::Patch<0, 2>> patches(p.size());
-        for (unsigned int i = 0; i < p.size(); ++i)
-          {
-            auto &patch       = patches[i];
-            patch.vertices[0] = dealii::Point<2>(p.position[i].x(), p.position[i].y());
-            patch.patch_index = i;
-            patch.data.reinit(6, 1);
-            patch.data(0, 0) = p.velocity[i].x();
-            patch.data(1, 0) = p.velocity[i].y();
-            patch.data(2, 0) = p.group[i];
-            patch.data(3, 0) = p.force[i].norm();
-            patch.data(4, 0) = ret_net[i];
-            patch.data(5, 0) = ret_bond[i];
-          }
-        const std::vector<std::string> names = {"velocity", "velocity", "group", "force",
-                                                "return_force_net", "return_force_bond"};
-        const std::vector<std::tuple<unsigned int, unsigned int, std::string,
-                                     dealii::DataComponentInterpretation::DataComponentInterpretation>>
-          ranges = {{0, 1, "velocity", dealii::DataComponentInterpretation::component_is_part_of_vector}};
-        dealii::DataOutBase::VtkFlags flags;
-        flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
-        std::ostringstream os;
-        dealii::DataOutBase::write_vtu(patches, names, ranges, flags, os);
-        char name[40];
-        std::snprintf(name, sizeof name, "particles_%05zu.vtu", files.size());
-        atomic_write(dir + "/" + name, os.str());
-        files.emplace_back(t, name);
-        std::ostringstream pvd;
-        dealii::DataOutBase::write_pvd_record(pvd, files);
-        atomic_write(dir + "/particles.pvd", pvd.str());
-      }
-      /// Snapshots written.
-      unsigned int n_snapshots() const { return static_cast<unsigned int>(files.size()); }
-
-    private:
-      std::string                                 dir;
-      std::vector<std::pair<double, std::string>> files;
-    };
+      std::vector<dealii::DataOutBase::Patch<0, 2>> patches(p.size());
+      for (unsigned int i = 0; i < p.size(); ++i)
+        {
+          auto &patch       = patches[i];
+          patch.vertices[0] = dealii::Point<2>(p.position[i].x(), p.position[i].y());
+          patch.patch_index = i;
+          patch.data.reinit(6, 1);
+          patch.data(0, 0) = p.velocity[i].x();
+          patch.data(1, 0) = p.velocity[i].y();
+          patch.data(2, 0) = p.group[i];
+          patch.data(3, 0) = p.force[i].norm();
+          patch.data(4, 0) = ret_net[i];
+          patch.data(5, 0) = ret_bond[i];
+        }
+      const std::vector<std::string> names = {"velocity", "velocity", "group", "force",
+                                              "return_force_net", "return_force_bond"};
+      const std::vector<std::tuple<unsigned int, unsigned int, std::string,
+                                   dealii::DataComponentInterpretation::DataComponentInterpretation>>
+        ranges = {{0, 1, "velocity", dealii::DataComponentInterpretation::component_is_part_of_vector}};
+      dealii::DataOutBase::VtkFlags flags;
+      flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
+      std::ostringstream os;
+      dealii::DataOutBase::write_vtu(patches, names, ranges, flags, os);
+      char name[40];
+      std::snprintf(name, sizeof name, "particles_%05u.vtu", fields.n_indexed("particles"));
+      atomic_write(fields.directory() + "/" + name, os.str());
+      fields.index("particles", t, name);
+    }
 
     // ------------------------------------------------------------------ scenes
 
@@ -286,6 +269,10 @@ namespace tribo::app
       virtual void finish(const Particles &p, const mlp::Box &box, const mlp::ForceField &field,
                           const TimeSeries &stats, double t, JsonObject &results,
                           std::map<std::string, TimeSeries> &tables) = 0;
+      /// Checkpoint: what the scene carries from step to step (loads, accumulators, tables
+      /// so far); what build() makes is rebuilt with the scene. Default: nothing.
+      virtual void save(CheckpointOut &) const {}
+      virtual void load(CheckpointIn &) {}
     };
 
     /// mlp_ordering: N particles at random positions (no two closer than d_min) in a
@@ -632,6 +619,23 @@ namespace tribo::app
           }
       }
 
+      /// The platens' load and velocities, the wave arrivals, the stroke flag and the
+      /// density maps so far.
+      void save(CheckpointOut &ar) const override
+      {
+        ar << current << platen_velocity << arrival << stroke_end << map_count << next_map;
+        maps_table.save(ar);
+        histogram_table.save(ar);
+        snapshot_stats.save(ar);
+      }
+      void load(CheckpointIn &ar) override
+      {
+        ar >> current >> platen_velocity >> arrival >> stroke_end >> map_count >> next_map;
+        maps_table.load(ar);
+        histogram_table.load(ar);
+        snapshot_stats.load(ar);
+      }
+
     private:
       CommonSettings s;
       unsigned int   nx = 0, ny = 0, maps = 0, map_count = 0;
@@ -821,6 +825,13 @@ namespace tribo::app
         results.set("slip_final", slip.back());
       }
 
+      /// The transverse load, the beams' displacements and the profile sums.
+      void save(CheckpointOut &ar) const override
+      {
+        ar << forcing << displacement << sum_net << sum_bond << samples;
+      }
+      void load(CheckpointIn &ar) override { ar >> forcing >> displacement >> sum_net >> sum_bond >> samples; }
+
     private:
       CommonSettings s;
       unsigned int   nx = 0, ny = 0, bins = 0;
@@ -973,10 +984,10 @@ namespace tribo::app
     checked_step(file, field, particles, s.langevin);
   }
 
-  int run_mlp_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o)
+  int run_mlp_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o,
+                    RunCheckpoint &checkpoint)
   {
     install_stop_handlers();
-    const auto        wall_start = std::chrono::steady_clock::now();
     const std::string scene_name = file.get("Simulation/Scene");
     JsonObject        summary;
     summary.set("case", o.case_file);
@@ -1024,12 +1035,12 @@ namespace tribo::app
     std::vector<std::string> columns = {"time", "step", "kinetic_energy", "kinetic_temperature", "n_pairs"};
     for (const auto &c : scene->columns())
       columns.push_back(c);
-    TimeSeries     stats(columns);
-    ParticleWriter writer(dir + "/fields");
-    const auto snapshot = [&](double t) {
+    TimeSeries  stats(columns);
+    FieldWriter fields(dir + "/fields");
+    const auto  snapshot = [&](double t) {
       std::vector<double> net, bond;
       return_force_magnitudes(*field, particles, box, net, bond);
-      writer.write(t, particles, net, bond);
+      write_particles(fields, t, particles, net, bond);
     };
     const auto row = [&](double t, unsigned long step) {
       const double ke = particles.kinetic_energy();
@@ -1051,11 +1062,41 @@ namespace tribo::app
     const double bound  = 0.5 * (hi - lo).norm() + 1000 * s.interaction.r0;
     scene->set_loads(particles, 0);
     field->compute(particles, box);
-    row(0, 0);
-    snapshot(0);
     std::string   status = "complete", failure;
     unsigned long step   = 0;
     double        t      = 0;
+    // After the header (RunCheckpoint), the step and every object's state, in this order.
+    const auto save_checkpoint = [&]() {
+      checkpoint.write([&](CheckpointOut &ar) {
+        ar << step;
+        particles.save(ar);
+        field->save(ar);
+        integrator->save(ar);
+        scene->save(ar);
+        stats.save(ar);
+        fields.save(ar);
+      });
+    };
+    if (checkpoint.resuming())
+      {
+        checkpoint.read(log, [&](CheckpointIn &ar) {
+          ar >> step;
+          particles.load(ar);
+          field->load(ar);
+          integrator->load(ar);
+          scene->load(ar);
+          stats.load(ar);
+          fields.load(ar);
+        });
+        t = step * dt;
+        log("resumed at step " + std::to_string(step) + " (t = " + to_text(t) + " s) of " +
+            std::to_string(n_steps));
+      }
+    else
+      {
+        row(0, 0);
+        snapshot(0);
+      }
     ProgressLine  progress(n_steps * dt, !o.quiet);
     auto          last_flush = std::chrono::steady_clock::now();
     try
@@ -1064,6 +1105,7 @@ namespace tribo::app
           {
             if (stop_requested())
               {
+                save_checkpoint();
                 status = "interrupted";
                 break;
               }
@@ -1086,6 +1128,14 @@ namespace tribo::app
                 last_flush = now;
               }
             progress.update(t, step);
+            const bool stopping = stop_requested() != 0;
+            if (stopping || (step != n_steps && !scene->finished() && checkpoint.due(step)))
+              save_checkpoint();
+            if (stopping)
+              {
+                status = "interrupted";
+                break;
+              }
             if (scene->finished())
               break;
           }
@@ -1104,7 +1154,7 @@ namespace tribo::app
     JsonObject                        results;
     std::map<std::string, TimeSeries> tables;
     scene->finish(particles, box, *field, stats, t, results, tables);
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double wall = checkpoint.wall_time();
     summary.set("status", status);
     if (!failure.empty())
       summary.set("error", failure);
@@ -1119,7 +1169,7 @@ namespace tribo::app
     summary.set("n_particles", long(particles.size()));
     summary.set("pair_stiffness", s.interaction.stiffness);
     summary.set("return_force_amplitude", s.interaction.f0);
-    summary.set("n_field_snapshots", long(writer.n_snapshots()));
+    summary.set("n_field_snapshots", long(fields.n_indexed("particles")));
     summary.set("results", results);
 
     atomic_write(dir + "/statistics.csv", stats.to_csv());
@@ -1130,6 +1180,8 @@ namespace tribo::app
                                                    {"complete", status == "complete" ? 1.0 : 0.0}};
     write_results_h5(dir + "/results.h5", stats, tables, file.resolved(), scalars);
     atomic_write(dir + "/summary.json", summary.to_string());
+    if (status == "complete")
+      checkpoint.remove();
 
     if (s.plots && status != "failed")
       {

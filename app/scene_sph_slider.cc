@@ -10,6 +10,7 @@
 #include "core/errors.h"
 #include "core/output.h"
 #include "core/run_control.h"
+#include "core/serialization.h"
 #include "sph/lattice.h"
 #include "sph/solver.h"
 
@@ -338,6 +339,10 @@ namespace tribo::app
       virtual std::vector<double> row(const sph::Solver<dim> &solver) = 0;
       /// Results of the run for summary.json "results" from the statistics.
       virtual void summarize(const TimeSeries &stats, double t_end, JsonObject &results) const = 0;
+      /// Checkpoint: what the scene carries from step to step (its accumulators and phase);
+      /// its groups of particles are rebuilt with it.
+      virtual void save(CheckpointOut &ar) const = 0;
+      virtual void load(CheckpointIn &ar)        = 0;
     };
 
     /// Output settings of the explicit loop.
@@ -349,25 +354,24 @@ namespace tribo::app
 
     /// The explicit time loop shared by the SPH scenes: RK2 steps until the end time,
     /// statistics rows every statistics interval of simulated time, VTU snapshots
-    /// fields/particles_NNNNN.vtu indexed in fields/particles.pvd, SIGINT/SIGTERM (status
-    /// "interrupted", exit 128 + N) and RunError (status "failed", exit 1), each keeping
-    /// the outputs of the steps done. Returns the exit code.
+    /// fields/particles_NNNNN.vtu indexed in fields/particles.pvd, checkpoints (and the
+    /// continuation of a resumed run) through @p checkpoint, SIGINT/SIGTERM (a checkpoint,
+    /// status "interrupted", exit 128 + N) and RunError (status "failed", exit 1), each
+    /// keeping the outputs of the steps done. Returns the exit code.
     template <int dim>
     int run_loop(sph::Solver<dim> &solver, Experiment<dim> &exp, const LoopSettings &ls,
                  const std::map<std::string, std::string> &parameters, JsonObject summary,
-                 const std::string &dir, Log &log, const RunOptions &o)
+                 const std::string &dir, Log &log, const RunOptions &o, RunCheckpoint &checkpoint)
     {
       install_stop_handlers();
-      const auto wall_start = std::chrono::steady_clock::now();
       std::vector<std::string> columns = {"time", "step", "dt"};
       for (const auto &c : exp.columns())
         columns.push_back(c);
       TimeSeries  stats(columns);
       FieldWriter fields((fs::path(dir) / "fields").string());
-      unsigned int n_fields = 0;
-      const auto snapshot = [&]() {
+      const auto  snapshot = [&]() {
         char name[40];
-        std::snprintf(name, sizeof name, "particles_%05u.vtu", n_fields++);
+        std::snprintf(name, sizeof name, "particles_%05u.vtu", fields.n_indexed("particles"));
         atomic_write((fs::path(dir) / "fields" / name).string(), particle_vtu(solver));
         fields.index("particles", solver.time, name);
       };
@@ -380,10 +384,37 @@ namespace tribo::app
         stats.add_row(row);
       };
       std::string status = "complete", failure;
-      snapshot();
-      add_row();
-      double       next_row   = ls.statistics_interval;
-      double       next_field = ls.field_interval > 0 ? ls.field_interval : 2 * ls.end_time;
+      double      next_row   = ls.statistics_interval;
+      double      next_field = ls.field_interval > 0 ? ls.field_interval : 2 * ls.end_time;
+      const auto  save_checkpoint = [&]() {
+        checkpoint.write([&](CheckpointOut &ar) {
+          ar << step << dt << dt_lo << dt_hi << next_row << next_field;
+          solver.save(ar);
+          exp.save(ar);
+          stats.save(ar);
+          fields.save(ar);
+        });
+      };
+      if (checkpoint.resuming())
+        {
+          checkpoint.read(log, [&](CheckpointIn &ar) {
+            ar >> step >> dt >> dt_lo >> dt_hi >> next_row >> next_field;
+            solver.load(ar);
+            exp.load(ar);
+            stats.load(ar);
+            fields.load(ar);
+          });
+          if (ls.field_interval <= 0) // first and last only, whatever the end time now
+            next_field = 2 * ls.end_time;
+          std::ostringstream os;
+          os << "resumed at step " << step << " (t = " << solver.time << " s) of the run to " << ls.end_time << " s";
+          log(os.str());
+        }
+      else
+        {
+          snapshot();
+          add_row();
+        }
       ProgressLine progress(ls.end_time, !o.quiet);
       auto         last_flush = std::chrono::steady_clock::now();
       try
@@ -392,6 +423,7 @@ namespace tribo::app
             {
               if (stop_requested())
                 {
+                  save_checkpoint();
                   status = "interrupted";
                   break;
                 }
@@ -401,13 +433,14 @@ namespace tribo::app
               dt_lo = std::min(dt_lo, dt);
               dt_hi = std::max(dt_hi, dt);
               exp.after_step(solver, dt);
+              const bool last = solver.time >= ls.end_time * (1 - 1e-12);
               if (solver.time >= next_row * (1 - 1e-12))
                 {
                   add_row();
                   while (next_row <= solver.time * (1 + 1e-12))
                     next_row += ls.statistics_interval;
                 }
-              if (solver.time >= next_field * (1 - 1e-12) && solver.time < ls.end_time * (1 - 1e-12))
+              if (solver.time >= next_field * (1 - 1e-12) && !last)
                 {
                   snapshot();
                   while (next_field <= solver.time * (1 + 1e-12))
@@ -419,6 +452,14 @@ namespace tribo::app
                 {
                   atomic_write((fs::path(dir) / "statistics.csv").string(), stats.to_csv());
                   last_flush = now;
+                }
+              const bool stopping = stop_requested() != 0;
+              if (stopping || (!last && checkpoint.due(step)))
+                save_checkpoint();
+              if (stopping)
+                {
+                  status = "interrupted";
+                  break;
                 }
             }
         }
@@ -432,7 +473,7 @@ namespace tribo::app
         add_row();
       snapshot();
 
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      const double wall = checkpoint.wall_time();
       summary.set("status", status);
       if (!failure.empty())
         summary.set("error", failure);
@@ -448,7 +489,7 @@ namespace tribo::app
       summary.set("dt_max", dt_hi);
       summary.set("last_step_limiter", solver.last_limiter());
       summary.set("n_particles", long(solver.state.size()));
-      summary.set("n_field_snapshots", long(n_fields));
+      summary.set("n_field_snapshots", long(fields.n_indexed("particles")));
       JsonObject results;
       exp.summarize(stats, solver.time, results);
       summary.set("results", results);
@@ -459,6 +500,8 @@ namespace tribo::app
       atomic_write((fs::path(dir) / "statistics.csv").string(), stats.to_csv());
       write_results_h5((fs::path(dir) / "results.h5").string(), stats, {}, parameters, scalars);
       atomic_write((fs::path(dir) / "summary.json").string(), summary.to_string());
+      if (status == "complete")
+        checkpoint.remove();
 
       std::ostringstream os;
       os << "status " << status << ": " << step << " steps to t = " << solver.time << " s in " << wall
@@ -676,6 +719,19 @@ namespace tribo::app
         res.set("n_contact_layer", long(contact.size()));
         res.set("n_driven", long(driven.size()));
         res.set("n_loaded", long(top.size()));
+      }
+
+      /// The phase, the interval sums, the works and the unwrapped block displacements
+      /// (the damping is the solver's).
+      void save(CheckpointOut &ar) const override
+      {
+        ar << sliding << sum_fx << sum_fn << displacement << work_pressure << work_drive << drive_impulse
+           << interval;
+      }
+      void load(CheckpointIn &ar) override
+      {
+        ar >> sliding >> sum_fx >> sum_fn >> displacement >> work_pressure >> work_drive >> drive_impulse >>
+          interval;
       }
 
     private:
@@ -949,7 +1005,7 @@ namespace tribo::app
     /// neighbour search's 3 cut-offs) and runs it; returns the exit code.
     template <int dim>
     int run_slider(EntryReader &r, const SliderParameters &p, const std::string &dir, Log &log,
-                   const RunOptions &o)
+                   const RunOptions &o, RunCheckpoint &checkpoint)
     {
       const double period = std::max(3.0, std::round(p.substrate[0] / p.spacing)) * p.spacing;
       if (p.periodic && period < 3 * 2 * std::max(p.smoothing_ratio, p.range_ratio) * p.spacing *
@@ -962,7 +1018,7 @@ namespace tribo::app
       summary.set("n_block", long(slider.n_block()));
       summary.set("n_substrate", long(slider.n_substrate()));
       return run_loop(solver, slider, {"sph_slider", p.end_time, p.statistics_interval, p.field_interval},
-                      r.read, summary, dir, log, o);
+                      r.read, summary, dir, log, o, checkpoint);
     }
 
     // ------------------------------------------------------------------------------------
@@ -1071,6 +1127,10 @@ namespace tribo::app
         res.set("energy_change_ratio", e.front() > 0 ? (e.back() - e.front()) / e.front() : 0.0);
       }
 
+      /// The tip's previous values and the zero crossings found so far.
+      void save(CheckpointOut &ar) const override { ar << t_prev << w_prev << v_prev << t_v0 << t_w0; }
+      void load(CheckpointIn &ar) override { ar >> t_prev >> w_prev >> v_prev >> t_v0 >> t_w0; }
+
     private:
       /// Mean vertical displacement @p w (m) and velocity @p v (m/s) of the tip column.
       void tip_state(const sph::Solver<2> &solver, double &w, double &v) const
@@ -1093,7 +1153,8 @@ namespace tribo::app
     };
 
     /// Reads "SPH plate", builds the plate and runs it; returns the exit code.
-    int run_plate(EntryReader &r, const std::string &dir, Log &log, const RunOptions &o)
+    int run_plate(EntryReader &r, const std::string &dir, Log &log, const RunOptions &o,
+                  RunCheckpoint &checkpoint)
     {
       const PlateParameters p = read_plate(r);
       sph::SolverParameters s;
@@ -1106,7 +1167,7 @@ namespace tribo::app
       JsonObject     summary;
       summary.set("case", o.case_file);
       return run_loop<2>(solver, plate, {"sph_plate", p.end_time, p.statistics_interval, p.field_interval},
-                         r.read, summary, dir, log, o);
+                         r.read, summary, dir, log, o, checkpoint);
     }
   } // namespace
 
@@ -1214,16 +1275,18 @@ namespace tribo::app
       read_slider(r);
   }
 
-  int run_sph_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o)
+  int run_sph_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o,
+                    RunCheckpoint &checkpoint)
   {
     EntryReader r(file);
     try
       {
         const std::string scene = r.text("Simulation/Scene");
         if (scene == "sph_plate")
-          return run_plate(r, dir, log, o);
+          return run_plate(r, dir, log, o, checkpoint);
         const SliderParameters p = read_slider(r);
-        return p.dim == 2 ? run_slider<2>(r, p, dir, log, o) : run_slider<3>(r, p, dir, log, o);
+        return p.dim == 2 ? run_slider<2>(r, p, dir, log, o, checkpoint)
+                          : run_slider<3>(r, p, dir, log, o, checkpoint);
       }
     catch (const InputError &e)
       {

@@ -15,8 +15,9 @@ namespace tribo
 {
   namespace
   {
-    /// First entry of every checkpoint: what it is and its layout version.
-    const std::string magic = "tribo checkpoint 1";
+    /// First entry of every checkpoint: what it is and its layout version (2: the wall time
+    /// follows the parameters, and the SPH and MLP scenes checkpoint).
+    const std::string magic = "tribo checkpoint 2";
   } // namespace
 
   void write_checkpoint(const std::string &path, const std::function<void(CheckpointOut &)> &save)

@@ -137,6 +137,12 @@ namespace tribo
     files.emplace_back(t, file);
     atomic_write(dir + "/" + series + ".pvd", pvd_text(files));
   }
+  unsigned int FieldWriter::n_indexed(const std::string &series) const
+  {
+    const auto it = series_files.find(series);
+    return it == series_files.end() ? 0 : static_cast<unsigned int>(it->second.size());
+  }
+
   void FieldWriter::save(CheckpointOut &ar) const
   {
     ar << disc_files << contact_files << series_files << times;

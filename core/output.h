@@ -106,6 +106,8 @@ namespace tribo
     /// SERIES.pvd, e.g. the snapshots of a deformable body next to the discs.
     void index(const std::string &series, double t, const std::string &file);
     unsigned int n_snapshots() const { return static_cast<unsigned int>(times.size()); }
+    /// Number of files in the index SERIES.pvd (see index()).
+    unsigned int n_indexed(const std::string &series) const;
     const std::string &directory() const { return dir; }
     /// Checkpoint: the snapshots indexed so far (the files themselves stay on disk).
     void save(CheckpointOut &ar) const;

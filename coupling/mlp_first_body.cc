@@ -108,9 +108,7 @@ namespace tribo::coupling
       void save(CheckpointOut &ar) const override
       {
         ar << total_dissipation() << gamma;
-        for (unsigned int i = 0; i < particles.size(); ++i)
-          ar << particles.position[i].x() << particles.position[i].y() << particles.velocity[i].x()
-             << particles.velocity[i].y();
+        particles.save(ar);
         save_base(ar);
       }
 
@@ -118,9 +116,7 @@ namespace tribo::coupling
       {
         double damped;
         ar >> damped >> gamma;
-        for (unsigned int i = 0; i < particles.size(); ++i)
-          ar >> particles.position[i].x() >> particles.position[i].y() >> particles.velocity[i].x() >>
-            particles.velocity[i].y();
+        particles.load(ar);
         potential_current = false;
         build_integrator(prm.time_step);
         dissipation_offset = damped - integrator->bath_work();

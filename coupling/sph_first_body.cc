@@ -108,26 +108,17 @@ namespace tribo::coupling
 
       void save(CheckpointOut &ar) const override
       {
-        const auto &s = solver.state;
-        ar << solver.time << total_dissipation() << bool(!solver.damping.empty());
-        for (unsigned int i = 0; i < s.size(); ++i)
-          ar << s.x[i][0] << s.x[i][1] << s.v[i][0] << s.v[i][1] << s.rho[i] << s.e[i] << s.S[i][0][0]
-             << s.S[i][1][1] << s.S[i][0][1];
+        ar << total_dissipation();
+        solver.save(ar);
         save_base(ar);
       }
 
       void load(CheckpointIn &ar) override
       {
-        auto  &s = solver.state;
         double damped;
-        bool   damping_on;
-        ar >> solver.time >> damped >> damping_on;
+        ar >> damped;
+        solver.load(ar);
         dissipation_offset = damped - solver.damping_dissipation();
-        if (!damping_on)
-          solver.damping.clear();
-        for (unsigned int i = 0; i < s.size(); ++i)
-          ar >> s.x[i][0] >> s.x[i][1] >> s.v[i][0] >> s.v[i][1] >> s.rho[i] >> s.e[i] >> s.S[i][0][0] >>
-            s.S[i][1][1] >> s.S[i][0][1];
         load_base(ar);
       }
 

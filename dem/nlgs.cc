@@ -1,5 +1,7 @@
 #include "dem/nlgs.h"
 
+#include "core/serialization.h"
+
 #include <deal.II/base/parallel.h>
 
 #include <algorithm>
@@ -71,18 +73,9 @@ namespace tribo::dem
     , rng(p.seed)
   {}
 
-  std::string NlgsSolver::random_state() const
-  {
-    std::ostringstream os;
-    os << rng;
-    return os.str();
-  }
+  std::string NlgsSolver::random_state() const { return engine_state(rng); }
 
-  void NlgsSolver::set_random_state(const std::string &state)
-  {
-    std::istringstream is(state);
-    is >> rng;
-  }
+  void NlgsSolver::set_random_state(const std::string &state) { set_engine_state(rng, state); }
 
   namespace
   {

@@ -1,6 +1,7 @@
 #include "mlp/interaction.h"
 
 #include "core/errors.h"
+#include "core/serialization.h"
 
 #include <deal.II/base/parallel.h>
 
@@ -240,5 +241,17 @@ namespace tribo::mlp
         s += model.force(d) * d.transpose();
       }
     return s / area;
+  }
+
+  void ForceField::save(CheckpointOut &ar) const
+  {
+    list.save(ar);
+    ar << pair_evaluations;
+  }
+
+  void ForceField::load(CheckpointIn &ar)
+  {
+    list.load(ar);
+    ar >> pair_evaluations;
   }
 } // namespace tribo::mlp

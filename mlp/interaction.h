@@ -154,6 +154,9 @@ namespace tribo::mlp
     const NeighbourList &neighbours() const { return list; }
     /// Number of pair force evaluations so far (pairs in the list per call).
     unsigned long long n_pair_evaluations() const { return pair_evaluations; }
+    /// Checkpoint: the neighbour list and the evaluation count.
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
 
   private:
     Interaction        model;

@@ -1,6 +1,7 @@
 #include "mlp/langevin.h"
 
 #include "core/errors.h"
+#include "core/serialization.h"
 #include "mlp/linear_theory.h"
 
 #include <algorithm>
@@ -131,5 +132,30 @@ namespace tribo::mlp
   {
     for (unsigned int k = 0; k < n; ++k)
       step(particles, box);
+  }
+
+  void RandomSource::save(CheckpointOut &ar) const
+  {
+    ar << engine_state(engine) << spare << has_spare;
+  }
+
+  void RandomSource::load(CheckpointIn &ar)
+  {
+    std::string state;
+    ar >> state >> spare >> has_spare;
+    set_engine_state(engine, state);
+  }
+
+  void LangevinIntegrator::save(CheckpointOut &ar) const
+  {
+    rng.save(ar);
+    ar << t << steps << to_bath << prm.damping << forces_current;
+  }
+
+  void LangevinIntegrator::load(CheckpointIn &ar)
+  {
+    rng.load(ar);
+    ar >> t >> steps >> to_bath >> prm.damping >> forces_current;
+    decay.clear(); // prepare() again for the restored damping
   }
 } // namespace tribo::mlp

@@ -71,6 +71,13 @@ namespace tribo::mlp
     /// The largest accepted step, safety * 2/omega_max, s.
     double max_time_step() const { return prm.safety * 2 / omega_max; }
 
+    /// Checkpoint: what a step carries to the next, bit for bit: the noise generator's
+    /// state, time, step count, bath work, the damping (set_damping() may have changed it)
+    /// and whether the forces are current. The force field saves its own neighbour list
+    /// (ForceField::save()), the particles their own state.
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
+
     /// Throws RunError naming the first particle with a non-finite position,
     /// velocity or force.
     static void check_finite(const Particles &particles, double time);

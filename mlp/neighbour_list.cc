@@ -1,6 +1,7 @@
 #include "mlp/neighbour_list.h"
 
 #include "core/errors.h"
+#include "core/serialization.h"
 
 #include <algorithm>
 #include <array>
@@ -183,5 +184,17 @@ namespace tribo::mlp
       return false;
     build(particles, box);
     return true;
+  }
+
+  void NeighbourList::save(CheckpointOut &ar) const
+  {
+    ar << pair_list << incidence_offset << incidences << build_positions << builds;
+    ar << build_box.periodic_x << build_box.lx << build_box.periodic_y << build_box.ly << build_box.tilt;
+  }
+
+  void NeighbourList::load(CheckpointIn &ar)
+  {
+    ar >> pair_list >> incidence_offset >> incidences >> build_positions >> builds;
+    ar >> build_box.periodic_x >> build_box.lx >> build_box.periodic_y >> build_box.ly >> build_box.tilt;
   }
 } // namespace tribo::mlp

@@ -26,6 +26,12 @@ namespace tribo::mlp
     {
       unsigned int pair;
       int          sign;
+      /// Boost.Serialization, either direction.
+      template <class Archive>
+      void serialize(Archive &ar, const unsigned int /*version*/)
+      {
+        ar &pair &sign;
+      }
     };
 
     /// A list for interactions of range @p cutoff (m) with Verlet skin @p skin (m).
@@ -58,6 +64,10 @@ namespace tribo::mlp
     double cutoff() const { return range; }
     /// Verlet skin, m.
     double skin() const { return skin_width; }
+    /// Checkpoint: the pairs in their order, the incidences and the positions and box of
+    /// the last build (a list rebuilt at another time would sum the forces in another order).
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
 
   private:
     double                                             range;

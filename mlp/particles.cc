@@ -1,6 +1,7 @@
 #include "mlp/particles.h"
 
 #include "core/errors.h"
+#include "core/serialization.h"
 #include "mlp/random.h"
 
 #include <algorithm>
@@ -155,5 +156,18 @@ namespace tribo::mlp
         particles.add(x, mass, group_id);
         ++placed;
       }
+  }
+  void Particles::save(CheckpointOut &ar) const
+  {
+    ar << position << velocity << force << external_force << mass << group << fixed;
+  }
+
+  void Particles::load(CheckpointIn &ar)
+  {
+    const unsigned int n = size();
+    ar >> position >> velocity >> force >> external_force >> mass >> group >> fixed;
+    if (size() != n || velocity.size() != n || fixed.size() != n)
+      throw InputError("checkpoint: it holds " + std::to_string(size()) +
+                       " MLP particles, this case builds " + std::to_string(n));
   }
 } // namespace tribo::mlp

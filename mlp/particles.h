@@ -6,6 +6,8 @@
 /// masses in kg/m, forces in N/m, energies in J/m. Coordinates are (x, y); the
 /// paper (Popov and Filippov 2006) calls the second coordinate z.
 
+#include "core/checkpoint.h"
+
 #include <Eigen/Core>
 
 #include <cmath>
@@ -92,6 +94,10 @@ namespace tribo::mlp
     double kinetic_energy() const;
     /// sum m v, kg/s.
     Vec2 momentum() const;
+    /// Checkpoint: every array, bit for bit.
+    void save(CheckpointOut &ar) const;
+    /// Restore what save() wrote; InputError if it holds another number of particles.
+    void load(CheckpointIn &ar);
   };
 
   /// The two lattices of the paper: six-fold (hexagonal, n = 6) and four-fold

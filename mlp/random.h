@@ -2,6 +2,8 @@
 /// @file Portable random numbers: the same seed gives the same sequence with any
 /// standard library (std::normal_distribution is implementation-defined).
 
+#include "core/checkpoint.h"
+
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -34,6 +36,11 @@ namespace tribo::mlp
       has_spare        = true;
       return rad * std::cos(ang);
     }
+
+    /// Checkpoint: the engine's state and the cached normal variate, so that the
+    /// sequence goes on as if never interrupted (defined in mlp/langevin.cc).
+    void save(CheckpointOut &ar) const;
+    void load(CheckpointIn &ar);
 
   private:
     std::mt19937_64 engine;

@@ -1,6 +1,7 @@
 #include "sph/solver.h"
 
 #include "core/errors.h"
+#include "core/serialization.h"
 
 #include <deal.II/base/parallel.h>
 
@@ -360,6 +361,34 @@ namespace tribo::sph
     apply_imposed(state, time);
     check_finite(state, "after the step");
     return dt;
+  }
+
+  template <int dim>
+  void Solver<dim>::save(CheckpointOut &ar) const
+  {
+    const auto &s = state;
+    ar << s.x << s.v << s.mass << s.rho << s.e << s.S << s.h << s.material << s.body;
+    ar << time << damped_energy << limiter << std::size_t(damping.size());
+    for (const Damping &d : damping)
+      ar << d.body << d.gamma << d.relative_to_centre_of_mass << d.reference_velocity;
+    ar << search.period << search.start << search.list << x_at_build << built_cutoff << builds;
+  }
+
+  template <int dim>
+  void Solver<dim>::load(CheckpointIn &ar)
+  {
+    const unsigned int n = state.size();
+    auto              &s = state;
+    ar >> s.x >> s.v >> s.mass >> s.rho >> s.e >> s.S >> s.h >> s.material >> s.body;
+    if (s.size() != n || s.v.size() != n || s.S.size() != n || s.body.size() != n)
+      throw InputError("checkpoint: it holds " + std::to_string(s.size()) +
+                       " SPH particles, this case builds " + std::to_string(n));
+    std::size_t n_damping;
+    ar >> time >> damped_energy >> limiter >> n_damping;
+    damping.resize(n_damping);
+    for (Damping &d : damping)
+      ar >> d.body >> d.gamma >> d.relative_to_centre_of_mass >> d.reference_velocity;
+    ar >> search.period >> search.start >> search.list >> x_at_build >> built_cutoff >> builds;
   }
 
   template <int dim>

@@ -5,6 +5,7 @@
 /// SI units throughout; 2D is plane strain with masses and forces per metre of
 /// depth. Pressure positive in compression, sigma = -P I + S, tension positive.
 
+#include "core/checkpoint.h"
 #include "sph/boundary_force.h"
 #include "sph/eos.h"
 #include "sph/kernel.h"
@@ -176,6 +177,17 @@ namespace tribo::sph
     double total_energy() const { return state.kinetic_energy() + state.internal_energy(); }
     /// Kinetic energy removed by the Damping terms since construction, J (>= 0).
     double damping_dissipation() const { return damped_energy; }
+
+    /// Checkpoint: what a step carries to the next, bit for bit: the particle state, the
+    /// time, the damping terms (a scene may switch them), the damped energy, the last step's
+    /// limiter and the neighbour list with the positions it was built at (a list rebuilt at
+    /// another time would sum the pairs in another order). The imposed velocities and
+    /// external forces are the scene's, rebuilt with it; the step size is not carried (each
+    /// step computes its own from the state).
+    void save(CheckpointOut &ar) const;
+    /// Restore what save() wrote; InputError if the checkpoint holds another number of
+    /// particles than this solver (another case).
+    void load(CheckpointIn &ar);
 
     /// "particle i (x = (..), v = (..), rho = ..)" for error messages.
     std::string describe_particle(const ParticleState<dim> &s, unsigned int i) const;

@@ -15,16 +15,14 @@ Usage: /usr/bin/python3 test_resume.py /path/to/tribo
 import filecmp
 import os
 import signal
-import subprocess
 import sys
-import time
 
 import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import tribo_cli  # noqa: E402
-from tribo_cli import TempDirTestCase, read_json, read_pvd, run, write_prm  # noqa: E402
+from tribo_cli import TempDirTestCase, read_json, read_pvd, run, run_and_stop, write_prm  # noqa: E402
 
 #: 3000 steps of a 60-disc shear cell, sliding from step 100, a checkpoint every 500 steps.
 CASE = {
@@ -52,20 +50,7 @@ class Resume(TempDirTestCase):
 
     def run_and_stop(self, out, sig, after_checkpoint_s=0.3):
         """Start a run into @p out, send @p sig once its first checkpoint exists."""
-        proc = subprocess.Popen([tribo_cli.TRIBO, "run", "case.prm", "--output", out, "--quiet"],
-                                cwd=self.tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                universal_newlines=True)
-        checkpoint = os.path.join(self.tmp, out, "checkpoint.bin")
-        deadline = time.monotonic() + 300
-        while not os.path.exists(checkpoint):
-            self.assertIsNone(proc.poll(), "the run ended before its first checkpoint")
-            self.assertLess(time.monotonic(), deadline, "no checkpoint within 300 s")
-            time.sleep(0.01)
-        time.sleep(after_checkpoint_s)
-        self.assertIsNone(proc.poll(), "the run ended before it could be stopped")
-        proc.send_signal(sig)
-        _, stderr = proc.communicate(timeout=120)
-        self.assertEqual(proc.returncode, -sig if sig == signal.SIGKILL else 128 + sig, stderr)
+        run_and_stop(self, self.tmp, "case.prm", out, sig, after_checkpoint_s)
 
     def assert_same_run(self, ref, resumed):
         a, b = os.path.join(self.tmp, ref), os.path.join(self.tmp, resumed)

@@ -18,9 +18,11 @@ import base64
 import csv
 import json
 import os
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 import xml.etree.ElementTree as ET
 import zlib
@@ -274,3 +276,22 @@ class TempDirTestCase(unittest.TestCase):
                 except OSError:
                     pass
         self._tmp.cleanup()
+
+
+def run_and_stop(testcase, cwd, case, out, sig, after_checkpoint_s=0.3):
+    """Start `tribo run CASE --output OUT` in @p cwd and send @p sig once its first
+    checkpoint exists (and @p after_checkpoint_s later); asserts the run was still going and
+    the exit status (-9 for SIGKILL, 128 + N for a signal the run catches)."""
+    proc = subprocess.Popen([TRIBO, "run", case, "--output", out, "--quiet"], cwd=cwd,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+    checkpoint = os.path.join(cwd, out, "checkpoint.bin")
+    deadline = time.monotonic() + 300
+    while not os.path.exists(checkpoint):
+        testcase.assertIsNone(proc.poll(), "the run ended before its first checkpoint")
+        testcase.assertLess(time.monotonic(), deadline, "no checkpoint within 300 s")
+        time.sleep(0.01)
+    time.sleep(after_checkpoint_s)
+    testcase.assertIsNone(proc.poll(), "the run ended before it could be stopped")
+    proc.send_signal(sig)
+    _, stderr = proc.communicate(timeout=120)
+    testcase.assertEqual(proc.returncode, -sig if sig == signal.SIGKILL else 128 + sig, stderr)
