@@ -1,7 +1,9 @@
 // Factorisation and solve times of the iteration matrix Mt = M + theta h C + theta^2 h^2 K
 // of the deal.II elastic body with CHOLMOD and UMFPACK, on the paper's body
 // (L = 1e-4 m, H = 1.5e-4 m, Q1): 72 x 107 cells (the paper's 7704), 104 x 156 and
-// 208 x 312 (twice as fine each way); then the assembly's time on 1 and 2 threads.
+// 208 x 312 (twice as fine each way); the Craig-Bampton reduced body with 0, 20 and 80
+// modes (rows "CB k": dofs of the reduced model, build includes the reduction); then the
+// assembly's time on 1 and 2 threads.
 // Usage: bench_fem [repeats (default 5)]     (docs/fem.md records the figures)
 #include "fem/elastic_body.h"
 
@@ -28,7 +30,8 @@ namespace
     Eigen::MatrixXd G;
   };
 
-  Timing run(unsigned int nx, unsigned int ny, const std::string &solver, unsigned int repeats)
+  /// @p modes < 0: the full model; otherwise the Craig-Bampton body with that many modes.
+  Timing run(unsigned int nx, unsigned int ny, const std::string &solver, unsigned int repeats, int modes = -1)
   {
     tribo::fem::ElasticBodyParameters p; // the paper's body: E = 100 GPa, nu = 0.33, rho = 7800
     p.length       = 1e-4;
@@ -38,10 +41,12 @@ namespace
     p.time_step    = 2e-9;
     p.top_pressure = 1e8;
     p.solver       = solver;
+    p.reduced      = modes >= 0;
+    p.modes        = std::max(modes, 0);
     Timing t;
     auto   t0 = Clock::now();
     tribo::fem::ElasticBody body(p);
-    t.build = seconds_since(t0); // mesh, assembly and the first factorisation
+    t.build = seconds_since(t0); // mesh, assembly, the reduction and the first factorisation
     std::mt19937                           rng(1);
     std::uniform_real_distribution<double> U(-1e-8, 1e-8);
     std::vector<Eigen::Vector2d>           R(body.n_boundary_nodes());
@@ -65,7 +70,8 @@ namespace
     t0           = Clock::now();
     t.G          = body.boundary_compliance();
     t.compliance = seconds_since(t0);
-    std::printf("%4u x %-4u %8u  %-8s %9.3f %10.3f %9.4f %9.4f %11.2f\n", nx, ny, body.n_dofs(), solver.c_str(),
+    const std::string name = modes < 0 ? solver : "CB " + std::to_string(modes);
+    std::printf("%4u x %-4u %8u  %-8s %9.3f %10.3f %9.4f %9.4f %11.2f\n", nx, ny, body.n_model_dofs(), name.c_str(),
                 t.build, t.factorize, t.predict, t.finalize, t.compliance);
     std::fflush(stdout);
     return t;
@@ -87,6 +93,13 @@ int main(int argc, char **argv)
     {
       const Timing c = run(mesh[0], mesh[1], "cholmod", repeats);
       const Timing u = run(mesh[0], mesh[1], "umfpack", repeats);
+      for (const int modes : {0, 20, 80})
+        {
+          const Timing r = run(mesh[0], mesh[1], "cholmod", repeats, modes);
+          std::printf("  Craig-Bampton, %d modes: compliance differs from the full model's by %.1e (relative, "
+                      "Frobenius), step (predict + finalize) %.0f times cheaper\n",
+                      modes, (r.G - c.G).norm() / c.G.norm(), (c.predict + c.finalize) / (r.predict + r.finalize));
+        }
       const double diff = (c.G - u.G).cwiseAbs().maxCoeff() / u.G.cwiseAbs().maxCoeff();
       std::printf("  faster: factorise %s (x%.1f), predict %s (x%.1f), compliance %s (x%.1f); "
                   "compliances agree to %.1e\n\n",
