@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The extremes matrix: short runs of the small shear cell (cases/shear/small.prm, 120
-discs) and of the collision scene at and beyond the edges of their parameters, each
+discs), of the collision scene and of the 2D SPH slider at and beyond the edges of their parameters, each
 recorded as completed (bounded energy, no NaN, solver converged or not) or stopped early
 with the message that names the limit it hit. Writes robustness.csv and robustness.md.
 
@@ -20,6 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 SHEAR = os.path.join(ROOT, "cases", "shear", "small.prm")
 COLLISION = os.path.join(ROOT, "cases", "collision", "iqs.prm")
+SPH_QUICK = os.path.join(ROOT, "cases", "sph_slider", "quick.prm")
 SHORT = {"Simulation/End time": "6e-6", "Output/Statistics interval": "10", "Output/Plots": "false"}
 
 # (group, label, case, overrides)
@@ -41,6 +42,14 @@ MATRIX = [
     ("first body E", "fem E = 3e9", SHEAR, {"Shear cell/Upper body model": "fem", "Shear cell/Upper body Young's modulus": "3e9"}),
     ("first body E", "fem E = 1e17 (1e6 x steel)", SHEAR,
      {"Shear cell/Upper body model": "fem", "Shear cell/Upper body Young's modulus": "1e17"}),
+    ("first body E", "reduced body (20 modes), E = 3e9", SHEAR,
+     {"Shear cell/Upper body model": "reduced", "Shear cell/Upper body Young's modulus": "3e9"}),
+    ("first body E", "reduced body (20 modes), E = 1e17", SHEAR,
+     {"Shear cell/Upper body model": "reduced", "Shear cell/Upper body Young's modulus": "1e17"}),
+    ("SPH damping", "slider, gamma = 1e9 1/s at P = 1e9 Pa (2/gamma = 2e-9 s)", SPH_QUICK,
+     {"SPH slider/Gamma": "1e9", "SPH slider/Pressure": "1e9", "Simulation/End time": "4e-4"}),
+    ("SPH damping", "slider, gamma = 0 at P = 1e9 Pa", SPH_QUICK,
+     {"SPH slider/Gamma": "0", "SPH slider/Pressure": "1e9", "Simulation/End time": "4e-4"}),
     ("time step", "h = 2e-10", SHEAR, {"Simulation/Time step": "2e-10", "Simulation/End time": "4e-6",
                                        "Shear cell/Shear start": "2e-6"}),
     ("time step", "h = 2e-8", SHEAR, {"Simulation/Time step": "2e-8"}),

@@ -20,6 +20,13 @@ profiles.csv. For every complete case:
 Writes tradeoff.csv, tradeoff.md and tradeoff.png (cost against the mu error and
 against the largest profile error, Pareto fronts drawn); exits 1 if the reference is
 not complete.
+
+A study of the collision scene (summary.json "scene" = collision) is measured on what
+that scene gives instead: cost = wall time of the collision, s; restitution_error =
+|e - e_ref| (e = v_out / v_in); energy_loss_error = |loss - loss_ref| (loss = 1 - KE_final
+/ KE_initial); duration_error = |t_c - t_c,ref| / t_c,ref (t_c the contact duration);
+outcome = whether the discs separated, as the reference did or not. The plot is cost
+against the restitution and the duration errors.
 """
 import csv
 import json
@@ -93,6 +100,8 @@ def main(directory):
     if not ref["complete"]:
         sys.exit(f"{directory}: the reference case ({ref['row']['directory']}) is not complete: "
                  f"status {ref['summary'].get('status')}")
+    if ref["summary"].get("scene") == "collision":
+        return collision_tradeoff(directory, cases)
     ref_results = ref["summary"]["results"]
     ref_profiles = read_profiles(os.path.join(ref["dir"], "profiles.csv"))
     mu_ref = ref_results.get("mu_mean")
@@ -171,6 +180,84 @@ def main(directory):
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("cost: wall s per simulated us")
+        ax.set_ylabel(label)
+    for k in knobs:
+        axes[0].plot([], [], "o", color=colours[k], label=k)
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    tmp = os.path.join(directory, "tradeoff.tmp.png")
+    fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    os.replace(tmp, os.path.join(directory, "tradeoff.png"))
+
+
+def collision_tradeoff(directory, cases):
+    """The tradeoff table and plot of a collision study (module docstring)."""
+    ref = cases[0]["summary"]["results"]
+    table = []
+    for c in cases:
+        s = c["summary"]
+        out = {"knob": c["row"]["knob"], "value": c["row"]["value"], "status": s.get("status", "missing"),
+               "directory": c["row"]["directory"]}
+        if c["complete"]:
+            r = s["results"]
+            out["cost"] = s["wall_time"]
+            out["steps"] = s.get("steps")
+            out["restitution"] = r.get("restitution_coefficient")
+            out["energy_loss"] = r.get("energy_loss")
+            out["separated"] = r.get("separated")
+            out["outcome_as_reference"] = r.get("separated") == ref.get("separated")
+            for key, name, relative in (("restitution_coefficient", "restitution_error", False),
+                                        ("energy_loss", "energy_loss_error", False),
+                                        ("contact_duration", "duration_error", True)):
+                a, b = r.get(key), ref.get(key)
+                ok = a is not None and b is not None and math.isfinite(a) and math.isfinite(b)
+                out[name] = (abs(a - b) / (abs(b) if relative else 1.0)) if ok else float("nan")
+        table.append(out)
+    ref_cost = table[0]["cost"]
+    for t in table:
+        if "cost" in t:
+            t["cost_ratio"] = t["cost"] / ref_cost
+    columns = ["knob", "value", "status", "cost", "cost_ratio", "steps", "restitution", "restitution_error",
+               "energy_loss", "energy_loss_error", "duration_error", "separated", "outcome_as_reference", "directory"]
+    tmp = os.path.join(directory, "tradeoff.csv.tmp")
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+        w.writeheader()
+        for t in table:
+            w.writerow({k: t.get(k, "") for k in columns})
+    os.replace(tmp, os.path.join(directory, "tradeoff.csv"))
+    md = [f"Reference: {table[0]['value']}; restitution {fmt(ref.get('restitution_coefficient'), 5)}, "
+          f"energy loss {fmt(ref.get('energy_loss'), 3)}, separated: {ref.get('separated')}.", "",
+          "| knob | value | wall time (s) | cost / reference | steps | restitution | restitution error | "
+          "energy loss | energy loss error | duration error | outcome as the reference | status |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for t in table:
+        md.append("| " + " | ".join([t["knob"], t["value"], fmt(t.get("cost")), fmt(t.get("cost_ratio")),
+                                     str(t.get("steps", "")), fmt(t.get("restitution"), 5),
+                                     fmt(t.get("restitution_error"), 2), fmt(t.get("energy_loss"), 3),
+                                     fmt(t.get("energy_loss_error"), 2), fmt(t.get("duration_error"), 2),
+                                     str(t.get("outcome_as_reference", "")), t["status"]]) + " |")
+    with open(os.path.join(directory, "tradeoff.md.tmp"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    os.replace(os.path.join(directory, "tradeoff.md.tmp"), os.path.join(directory, "tradeoff.md"))
+
+    rungs = [t for t in table if "cost" in t and t["knob"] != "reference"]
+    knobs = sorted({t["knob"] for t in rungs})
+    colours = {k: f"C{i}" for i, k in enumerate(knobs)}
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    for ax, key, label in ((axes[0], "restitution_error", "|e - e_ref|"),
+                           (axes[1], "duration_error", "|t_c - t_c,ref| / t_c,ref")):
+        pts = [(t["cost"], t[key], t) for t in rungs if math.isfinite(t[key]) and t[key] > 0]
+        for c, e, t in pts:
+            ax.plot(c, e, "o", color=colours[t["knob"]])
+            ax.annotate(t["value"], (c, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
+        front = pareto([(c, e) for c, e, _ in pts])
+        ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, label="Pareto front")
+        ax.axvline(ref_cost, color="k", lw=1, label="reference cost (its error is 0)")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("cost: wall s per collision")
         ax.set_ylabel(label)
     for k in knobs:
         axes[0].plot([], [], "o", color=colours[k], label=k)

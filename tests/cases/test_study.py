@@ -220,6 +220,36 @@ class Tradeoff(unittest.TestCase):
             self.assertIn("its standard error (batch means)", f.read())
         self.assertGreater(os.path.getsize(os.path.join(out, "tradeoff.png")), 10000)
 
+    def test_collision_ladder_converges_at_first_order(self):
+        # The shipped collision ladder (cases/collision/tradeoff.prm): the ELAS collision
+        # at 2 m/s loses energy only through the step, at first order: loss ~ C dt/dt*.
+        case = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "cases", "collision",
+                            "tradeoff.prm")
+        out = os.path.join(self.dir, "collision")
+        p = subprocess.run([TRIBO, "tradeoff", case, "--output", out, "--quiet"], capture_output=True,
+                           text=True, timeout=600)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        with open(os.path.join(out, "tradeoff.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([r["status"] for r in rows], ["complete"] * len(rows))
+        self.assertTrue(all(r["outcome_as_reference"] == "True" for r in rows))
+        with open(os.path.join(out, rows[0]["directory"], "summary.json")) as f:
+            ref = json.load(f)["results"]
+        ladder = [r for r in rows if r["knob"] == "Collision/Time step ratio" and r["value"] != "10000"]
+        ratios = [float(r["value"]) for r in ladder]
+        self.assertEqual(ratios, [3, 10, 30, 100, 300, 1000])
+        errors = [float(r["restitution_error"]) for r in ladder]
+        self.assertEqual(errors, sorted(errors, reverse=True))  # finer steps, smaller errors
+        for r, ratio in zip(ladder, ratios):
+            self.assertAlmostEqual(float(r["restitution_error"]),
+                                   abs(float(r["restitution"]) - ref["restitution_coefficient"]), delta=1e-12)
+            if ratio >= 10:
+                self.assertGreater(float(r["energy_loss"]) * ratio, 1.4)
+                self.assertLess(float(r["energy_loss"]) * ratio, 2.0)
+        # One contact: every tolerance converges in the first sweep, the same result.
+        tolerance = [r for r in rows if r["knob"] == "Solver/Tolerance"]
+        self.assertEqual(len({r["restitution"] for r in tolerance}), 1)
+
     def test_bad_tradeoff_input_fails_before_running(self):
         p, path, out = self.tradeoff("Contact law/Cohesion = 60")
         self.assertEqual(p.returncode, 2)
