@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #ifdef TRIBO_WITH_FEM
 #include "coupling/elastic_boundary.h"
@@ -36,8 +38,29 @@ namespace tribo::coupling
     return std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu) * p.density));
   }
 
+  namespace
+  {
+    /// Cells of the fem and reduced bodies' mesh along x and y.
+    std::pair<unsigned int, unsigned int> fem_cells(const FirstBodyParameters &p)
+    {
+      return {chain_nodes(p), static_cast<unsigned int>(std::max(1L, std::lround(p.thickness / p.resolution)))};
+    }
+  } // namespace
+
   void check_first_body(const FirstBodyParameters &p)
   {
+    if (p.model == "reduced")
+      {
+        // Interior unknowns with the bottom nodes and the top's x held: the mesh's
+        // 2 (nx p)(ny p + 1) periodic unknowns less 2 nx and nx p.
+        const auto [nx, ny] = fem_cells(p);
+        const long nxp = long(nx) * p.degree, nyp = long(ny) * p.degree;
+        const long interior = 2 * nxp * (nyp + 1) - 2 * long(nx) - nxp;
+        if (long(p.modes) + 2 > interior)
+          throw InputError("entry 'Shear cell/Upper body modes' = '" + std::to_string(p.modes) +
+                           "': expected at most " + std::to_string(interior - 2) + ", the body's " +
+                           std::to_string(interior) + " interior unknowns less 2");
+      }
     if (p.model != "sph" && p.model != "mlp")
       return;
     if (p.model == "mlp" && p.poisson_ratio > 0.25 + 1e-12)
@@ -95,8 +118,7 @@ namespace tribo::coupling
       e.youngs_modulus = p.youngs_modulus;
       e.poisson_ratio  = p.poisson_ratio;
       e.density        = p.density;
-      e.cells_x        = chain_nodes(p);
-      e.cells_y        = std::max(1L, std::lround(p.thickness / p.resolution));
+      std::tie(e.cells_x, e.cells_y) = fem_cells(p);
       if (double(e.cells_x) * e.cells_y > 4e6)
         throw InputError("entry 'Shear cell/Upper body cell size' = '" + to_text(p.resolution) +
                          "': expected a cell size giving at most 4e6 cells; it gives " +

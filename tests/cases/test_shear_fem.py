@@ -165,6 +165,21 @@ class BadInput(unittest.TestCase):
             self.assertIn("a Poisson ratio in (-1, 0.5)", p.stderr)
             self.assertIn("case.prm:", p.stderr)
 
+    def test_more_modes_than_the_reduced_body_has_are_refused_before_writing(self):
+        # 13 x 156 Q1 cells: 2 * 13 * 157 periodic unknowns less 26 boundary and 13 top x.
+        with tempfile.TemporaryDirectory() as tmp:
+            case = os.path.join(tmp, "case.prm")
+            with open(case, "w") as f:
+                f.write(base.CASE)
+            out = os.path.join(tmp, "out")
+            p = subprocess.run([TRIBO, "run", case, "--output", out, "--set", "Shear cell/Upper body model=reduced",
+                                "--set", "Shear cell/Upper body modes=5000"], capture_output=True, text=True,
+                               timeout=60)
+            self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+            self.assertIn("entry 'Shear cell/Upper body modes' = '5000': expected at most 4041, the body's "
+                          "4043 interior unknowns less 2", p.stderr)
+            self.assertFalse(os.path.exists(out))
+
     def test_a_mesh_too_fine_is_refused(self):
         with tempfile.TemporaryDirectory() as tmp:
             case = os.path.join(tmp, "case.prm")
