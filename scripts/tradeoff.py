@@ -82,6 +82,69 @@ def fmt(v, digits=3):
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{digits}g}"
 
 
+def tabulate(cases, measure):
+    """One row per case: knob, value, status and directory, then measure(case, row) fills
+    a complete case's figures, "cost" among them; cost_ratio is cost over case 0's."""
+    table = []
+    for c in cases:
+        s = c["summary"]
+        out = {"knob": c["row"]["knob"], "value": c["row"]["value"], "status": s.get("status", "missing"),
+               "directory": c["row"]["directory"]}
+        if c["complete"]:
+            measure(c, out)
+        table.append(out)
+    for t in table:
+        if "cost" in t:
+            t["cost_ratio"] = t["cost"] / table[0]["cost"]
+    return table
+
+
+def write_outputs(directory, table, columns, md, panels, ref_cost, cost_label, hlines=()):
+    """tradeoff.csv (@p columns of @p table), tradeoff.md (the lines @p md) and tradeoff.png,
+    each written atomically. @p panels: (row key or function of a row, y label) per subplot;
+    each plots cost against that error for every rung, with the Pareto front and the
+    reference's cost; @p hlines: (panel index, y, label) reference lines."""
+    tmp = os.path.join(directory, "tradeoff.csv.tmp")
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+        w.writeheader()
+        for t in table:
+            w.writerow({k: t.get(k, "") for k in columns})
+    os.replace(tmp, os.path.join(directory, "tradeoff.csv"))
+    with open(os.path.join(directory, "tradeoff.md.tmp"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    os.replace(os.path.join(directory, "tradeoff.md.tmp"), os.path.join(directory, "tradeoff.md"))
+
+    rungs = [t for t in table if "cost" in t and t["knob"] != "reference"]
+    knobs = sorted({t["knob"] for t in rungs})
+    colours = {k: f"C{i}" for i, k in enumerate(knobs)}
+    fig, axes = plt.subplots(1, len(panels), figsize=(11, 4.5))
+    for ax, (key, label) in zip(axes, panels):
+        error = key if callable(key) else (lambda t, key=key: t[key])
+        pts = [(t["cost"], error(t), t) for t in rungs]
+        pts = [(c, e, t) for c, e, t in pts if math.isfinite(c) and math.isfinite(e) and e > 0]
+        for c, e, t in pts:
+            ax.plot(c, e, "o", color=colours[t["knob"]])
+            ax.annotate(t["value"], (c, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
+        front = pareto([(c, e) for c, e, _ in pts])
+        ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, label="Pareto front")
+        ax.axvline(ref_cost, color="k", lw=1, label="reference cost (its error is 0)")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(cost_label)
+        ax.set_ylabel(label)
+    for i, y, label in hlines:
+        axes[i].axhline(y, color="grey", lw=0.8, ls=":", label=label)
+    for k in knobs:
+        axes[0].plot([], [], "o", color=colours[k], label=k)
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    tmp = os.path.join(directory, "tradeoff.tmp.png")
+    fig.savefig(tmp, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    os.replace(tmp, os.path.join(directory, "tradeoff.png"))
+
+
 def main(directory):
     with open(os.path.join(directory, "study_summary.csv")) as f:
         rows = list(csv.DictReader(f))
@@ -108,42 +171,28 @@ def main(directory):
     scatter = batch_standard_error(os.path.join(ref["dir"], "statistics.csv"),
                                    ref_results.get("steady_state_start") or 0.0)
 
-    table = []
-    for c in cases:
+    def measure(c, out):
         s = c["summary"]
-        out = {"knob": c["row"]["knob"], "value": c["row"]["value"], "status": s.get("status", "missing"),
-               "directory": c["row"]["directory"]}
-        if c["complete"]:
-            res = s["results"]
-            out["cost"] = s["wall_time"] / (s["simulated_time"] * 1e6)
-            mu = res.get("mu_mean")
-            out["mu_mean"] = mu
-            out["mu_error"] = abs(mu - mu_ref) / abs(mu_ref) if mu is not None and mu_ref else float("nan")
-            prof = read_profiles(os.path.join(c["dir"], "profiles.csv"))
-            for q in PROFILES:
-                out[q + "_l2"] = (relative_l2(prof, ref_profiles, q)
-                                  if prof is not None and ref_profiles is not None else float("nan"))
-            ratio = res.get("power_balance_ratio")
-            out["balance_residual"] = abs(1 - ratio) if ratio is not None else float("nan")
-            out["nlgs_sweeps_per_step"] = s.get("nlgs_iterations_mean")
-            out["steady_state_reached"] = res.get("steady_state_reached")
-        table.append(out)
+        res = s["results"]
+        out["cost"] = s["wall_time"] / (s["simulated_time"] * 1e6)
+        mu = res.get("mu_mean")
+        out["mu_mean"] = mu
+        out["mu_error"] = abs(mu - mu_ref) / abs(mu_ref) if mu is not None and mu_ref else float("nan")
+        prof = read_profiles(os.path.join(c["dir"], "profiles.csv"))
+        for q in PROFILES:
+            out[q + "_l2"] = (relative_l2(prof, ref_profiles, q)
+                              if prof is not None and ref_profiles is not None else float("nan"))
+        ratio = res.get("power_balance_ratio")
+        out["balance_residual"] = abs(1 - ratio) if ratio is not None else float("nan")
+        out["nlgs_sweeps_per_step"] = s.get("nlgs_iterations_mean")
+        out["steady_state_reached"] = res.get("steady_state_reached")
+
+    table = tabulate(cases, measure)
     ref_cost = table[0]["cost"]
-    for t in table:
-        if "cost" in t:
-            t["cost_ratio"] = t["cost"] / ref_cost
 
     columns = ["knob", "value", "status", "cost", "cost_ratio", "mu_mean", "mu_error", "vx_l2",
                "sigma_yy_l2", "sigma_xy_l2", "balance_residual", "nlgs_sweeps_per_step",
                "steady_state_reached", "directory"]
-    tmp = os.path.join(directory, "tradeoff.csv.tmp")
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
-        w.writeheader()
-        for t in table:
-            w.writerow({k: t.get(k, "") for k in columns})
-    os.replace(tmp, os.path.join(directory, "tradeoff.csv"))
-
     md = [f"Reference: {table[0]['value']}; mean mu {fmt(mu_ref, 4)}, its standard error "
           f"(batch means) {fmt(scatter, 2)}: mu errors below about {fmt(2 * scatter / mu_ref if mu_ref else float('nan'), 2)} "
           "are within the noise.", "",
@@ -156,77 +205,39 @@ def main(directory):
                                      fmt(t.get("sigma_yy_l2"), 2), fmt(t.get("sigma_xy_l2"), 2),
                                      fmt(t.get("balance_residual"), 2), fmt(t.get("nlgs_sweeps_per_step"), 4),
                                      t["status"]]) + " |")
-    with open(os.path.join(directory, "tradeoff.md.tmp"), "w") as f:
-        f.write("\n".join(md) + "\n")
-    os.replace(os.path.join(directory, "tradeoff.md.tmp"), os.path.join(directory, "tradeoff.md"))
-
-    done = [t for t in table if "cost" in t]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    knobs = sorted({t["knob"] for t in done if t["knob"] != "reference"})
-    colours = {k: f"C{i}" for i, k in enumerate(knobs)}
-    rungs = [t for t in done if t["knob"] != "reference"]
-    for ax, key, label in ((axes[0], "mu_error", "|mu - mu_ref| / mu_ref"),
-                           (axes[1], None, "largest profile L2 error (vx, sigma_yy, sigma_xy)")):
-        err = [t[key] if key else max(t[q + "_l2"] for q in PROFILES) for t in rungs]
-        cost = [t["cost"] for t in rungs]
-        for t, c, e in zip(rungs, cost, err):
-            ax.plot(c, e, "o", color=colours[t["knob"]])
-            ax.annotate(t["value"], (c, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
-        front = pareto(list(zip(cost, err)))
-        ax.plot([cost[i] for i in front], [err[i] for i in front], "k--", lw=1, label="Pareto front")
-        ax.axvline(ref_cost, color="k", lw=1, label="reference cost (its error is 0)")
-        if key == "mu_error" and math.isfinite(scatter) and mu_ref:
-            ax.axhline(2 * scatter / mu_ref, color="grey", lw=0.8, ls=":", label="2 x standard error of mu_ref")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("cost: wall s per simulated us")
-        ax.set_ylabel(label)
-    for k in knobs:
-        axes[0].plot([], [], "o", color=colours[k], label=k)
-    axes[0].legend(fontsize=7)
-    fig.tight_layout()
-    tmp = os.path.join(directory, "tradeoff.tmp.png")
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, os.path.join(directory, "tradeoff.png"))
+    hlines = ([(0, 2 * scatter / mu_ref, "2 x standard error of mu_ref")]
+              if math.isfinite(scatter) and mu_ref else [])
+    write_outputs(directory, table, columns, md,
+                  [("mu_error", "|mu - mu_ref| / mu_ref"),
+                   (lambda t: max(t[q + "_l2"] for q in PROFILES),
+                    "largest profile L2 error (vx, sigma_yy, sigma_xy)")],
+                  ref_cost, "cost: wall s per simulated us", hlines)
 
 
 def collision_tradeoff(directory, cases):
     """The tradeoff table and plot of a collision study (module docstring)."""
     ref = cases[0]["summary"]["results"]
-    table = []
-    for c in cases:
+
+    def measure(c, out):
         s = c["summary"]
-        out = {"knob": c["row"]["knob"], "value": c["row"]["value"], "status": s.get("status", "missing"),
-               "directory": c["row"]["directory"]}
-        if c["complete"]:
-            r = s["results"]
-            out["cost"] = s["wall_time"]
-            out["steps"] = s.get("steps")
-            out["restitution"] = r.get("restitution_coefficient")
-            out["energy_loss"] = r.get("energy_loss")
-            out["separated"] = r.get("separated")
-            out["outcome_as_reference"] = r.get("separated") == ref.get("separated")
-            for key, name, relative in (("restitution_coefficient", "restitution_error", False),
-                                        ("energy_loss", "energy_loss_error", False),
-                                        ("contact_duration", "duration_error", True)):
-                a, b = r.get(key), ref.get(key)
-                ok = a is not None and b is not None and math.isfinite(a) and math.isfinite(b)
-                out[name] = (abs(a - b) / (abs(b) if relative else 1.0)) if ok else float("nan")
-        table.append(out)
+        r = s["results"]
+        out["cost"] = s["wall_time"]
+        out["steps"] = s.get("steps")
+        out["restitution"] = r.get("restitution_coefficient")
+        out["energy_loss"] = r.get("energy_loss")
+        out["separated"] = r.get("separated")
+        out["outcome_as_reference"] = r.get("separated") == ref.get("separated")
+        for key, name, relative in (("restitution_coefficient", "restitution_error", False),
+                                    ("energy_loss", "energy_loss_error", False),
+                                    ("contact_duration", "duration_error", True)):
+            a, b = r.get(key), ref.get(key)
+            ok = a is not None and b is not None and math.isfinite(a) and math.isfinite(b)
+            out[name] = (abs(a - b) / (abs(b) if relative else 1.0)) if ok else float("nan")
+
+    table = tabulate(cases, measure)
     ref_cost = table[0]["cost"]
-    for t in table:
-        if "cost" in t:
-            t["cost_ratio"] = t["cost"] / ref_cost
     columns = ["knob", "value", "status", "cost", "cost_ratio", "steps", "restitution", "restitution_error",
                "energy_loss", "energy_loss_error", "duration_error", "separated", "outcome_as_reference", "directory"]
-    tmp = os.path.join(directory, "tradeoff.csv.tmp")
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
-        w.writeheader()
-        for t in table:
-            w.writerow({k: t.get(k, "") for k in columns})
-    os.replace(tmp, os.path.join(directory, "tradeoff.csv"))
     md = [f"Reference: {table[0]['value']}; restitution {fmt(ref.get('restitution_coefficient'), 5)}, "
           f"energy loss {fmt(ref.get('energy_loss'), 3)}, separated: {ref.get('separated')}.", "",
           "| knob | value | wall time (s) | cost / reference | steps | restitution | restitution error | "
@@ -238,35 +249,9 @@ def collision_tradeoff(directory, cases):
                                      fmt(t.get("restitution_error"), 2), fmt(t.get("energy_loss"), 3),
                                      fmt(t.get("energy_loss_error"), 2), fmt(t.get("duration_error"), 2),
                                      str(t.get("outcome_as_reference", "")), t["status"]]) + " |")
-    with open(os.path.join(directory, "tradeoff.md.tmp"), "w") as f:
-        f.write("\n".join(md) + "\n")
-    os.replace(os.path.join(directory, "tradeoff.md.tmp"), os.path.join(directory, "tradeoff.md"))
-
-    rungs = [t for t in table if "cost" in t and t["knob"] != "reference"]
-    knobs = sorted({t["knob"] for t in rungs})
-    colours = {k: f"C{i}" for i, k in enumerate(knobs)}
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    for ax, key, label in ((axes[0], "restitution_error", "|e - e_ref|"),
-                           (axes[1], "duration_error", "|t_c - t_c,ref| / t_c,ref")):
-        pts = [(t["cost"], t[key], t) for t in rungs if math.isfinite(t[key]) and t[key] > 0]
-        for c, e, t in pts:
-            ax.plot(c, e, "o", color=colours[t["knob"]])
-            ax.annotate(t["value"], (c, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
-        front = pareto([(c, e) for c, e, _ in pts])
-        ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, label="Pareto front")
-        ax.axvline(ref_cost, color="k", lw=1, label="reference cost (its error is 0)")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("cost: wall s per collision")
-        ax.set_ylabel(label)
-    for k in knobs:
-        axes[0].plot([], [], "o", color=colours[k], label=k)
-    axes[0].legend(fontsize=7)
-    fig.tight_layout()
-    tmp = os.path.join(directory, "tradeoff.tmp.png")
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, os.path.join(directory, "tradeoff.png"))
+    write_outputs(directory, table, columns, md,
+                  [("restitution_error", "|e - e_ref|"), ("duration_error", "|t_c - t_c,ref| / t_c,ref")],
+                  ref_cost, "cost: wall s per collision")
 
 
 if __name__ == "__main__":
