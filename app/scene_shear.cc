@@ -220,6 +220,24 @@ namespace tribo::app
         j.set("power_dissipated_mean", p_diss);
         j.set("power_third_body_mean", stat("power_free").first);
         j.set("power_balance_ratio", p_lb != 0 ? p_diss / p_lb : NAN);
+        // The whole balance: what the walls put in goes into dissipation (contacts and a
+        // deformable body's damping) or into the energy the grains and the body hold.
+        {
+          const auto   e_grains = stats.column("kinetic_energy");
+          const auto   e_body_k = stats.column("kinetic_energy_upper_wall");
+          const auto   e_body_s = stats.column("elastic_energy_upper_body");
+          const auto   first    = std::lower_bound(time.begin(), time.end(), start) - time.begin();
+          const auto   last     = time.size() - 1;
+          const auto   energy   = [&](std::size_t i) {
+            return e_grains[i] + (body ? e_body_k[i] + e_body_s[i] : 0.0);
+          };
+          const double span     = time[last] - time[first];
+          const double rate     = span > 0 ? (energy(last) - energy(first)) / span : 0.0;
+          const double p_damp   = stat("power_damping_upper_body").first;
+          j.set("energy_rate_mean", rate);
+          j.set("power_balance_closure",
+                p_lb + p_ub != 0 ? (p_diss + p_damp + rate) / (p_lb + p_ub) : NAN);
+        }
         j.set("inertial_number", std::abs(k.sliding_velocity) / h_tb * mean_grain_diameter *
                                    std::sqrt(k.density / k.pressure));
         j.set("profile_samples_in_steady_state", long(profiles->n_samples_after(steady.start)));

@@ -16,8 +16,9 @@ namespace tribo
   namespace
   {
     /// First entry of every checkpoint: what it is and its layout version (2: the wall time
-    /// follows the parameters, and the SPH and MLP scenes checkpoint).
-    const std::string magic = "tribo checkpoint 2";
+    /// follows the parameters, and the SPH and MLP scenes checkpoint; 3: the SPH solver
+    /// carries its viscous heat).
+    const std::string magic = "tribo checkpoint 3";
   } // namespace
 
   void write_checkpoint(const std::string &path, const std::function<void(CheckpointOut &)> &save)

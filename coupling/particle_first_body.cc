@@ -80,11 +80,14 @@ namespace tribo::coupling
       throw RunError("particle first body: " + std::to_string(impulses.size()) + " node impulses for " +
                      std::to_string(chain.size()) + " chain particles");
     const double stored_before = stored_energy();
+    std::vector<dem::Vec2> dv(impulses.size()), dx(impulses.size());
     for (std::size_t i = 0; i < impulses.size(); ++i)
       {
-        const dem::Vec2 dv = G(2 * i, 2 * i) * impulses[i];
-        kick(chain[i], dv, prm.theta * step_h * dv);
+        dv[i] = G(2 * i, 2 * i) * impulses[i];
+        dx[i] = prm.theta * step_h * dv[i];
       }
+    if (!impulses.empty())
+      kick(chain, dv, dx);
     correction_work = impulses.empty() ? 0.0 : stored_energy() - stored_before;
     time += step_h;
     for (unsigned int i = 0; i < chain.size(); ++i)

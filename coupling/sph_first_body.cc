@@ -80,7 +80,9 @@ namespace tribo::coupling
         return os.str();
       }
 
-      double stored_energy() const override { return solver.state.internal_energy(); }
+      /// The elastic energy: the internal energy sum m e less the artificial viscosity's
+      /// heat, which is booked as dissipation inside the body (total_dissipation()), J/m.
+      double stored_energy() const override { return solver.state.internal_energy() - solver.viscous_heat(); }
       void   start_shearing() override { solver.damping.clear(); }
 
       std::string write_fields(const std::string &dir, unsigned int index) const override
@@ -118,7 +120,7 @@ namespace tribo::coupling
         double damped;
         ar >> damped;
         solver.load(ar);
-        dissipation_offset = damped - solver.damping_dissipation();
+        dissipation_offset = damped - solver.damping_dissipation() - solver.viscous_heat();
         load_base(ar);
       }
 
@@ -127,21 +129,31 @@ namespace tribo::coupling
       dem::Vec2    position(unsigned int p) const override { return {solver.state.x[p][0], solver.state.x[p][1]}; }
       dem::Vec2    velocity(unsigned int p) const override { return {solver.state.v[p][0], solver.state.v[p][1]}; }
       double       mass(unsigned int p) const override { return solver.state.mass[p]; }
-      void         kick(unsigned int p, const dem::Vec2 &dv, const dem::Vec2 &dx) override
+      /// The velocities change directly; the positions through sph::Solver::displace(),
+      /// so that the density, stress and internal energy see the position term.
+      void kick(const std::vector<unsigned int> &p, const std::vector<dem::Vec2> &dv,
+                const std::vector<dem::Vec2> &dx) override
       {
-        auto &s = solver.state;
-        s.v[p][0] += dv.x();
-        s.v[p][1] += dv.y();
-        s.x[p][0] += dx.x();
-        s.x[p][1] += dx.y();
-        s.x[p][0] -= prm.length * std::floor(s.x[p][0] / prm.length);
+        auto                     &s = solver.state;
+        std::vector<Tensor<1, 2>> shift(p.size());
+        for (std::size_t q = 0; q < p.size(); ++q)
+          {
+            s.v[p[q]][0] += dv[q].x();
+            s.v[p[q]][1] += dv[q].y();
+            shift[q] = Tensor<1, 2>({dx[q].x(), dx[q].y()});
+          }
+        solver.displace(p, shift);
       }
       unsigned int advance(double h, double load) override
       {
         solver.external[0].force = Tensor<1, 2>({0, load});
         return solver.advance_to(solver.time + h);
       }
-      double total_dissipation() const override { return dissipation_offset + solver.damping_dissipation(); }
+      /// The compaction damping's work and the artificial viscosity's heat, J/m.
+      double total_dissipation() const override
+      {
+        return dissipation_offset + solver.damping_dissipation() + solver.viscous_heat();
+      }
 
     private:
       static sph::SolverParameters parameters(const FirstBodyParameters &p)

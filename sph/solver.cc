@@ -34,6 +34,7 @@ namespace tribo::sph
       k.boundary_force.assign(n, Tensor<1, dim>());
       k.pressure.assign(n, 0);
       k.signal.assign(n, 0);
+      k.viscous_heating.assign(n, 0);
     }
 
     template <typename F>
@@ -85,7 +86,7 @@ namespace tribo::sph
   }
 
   template <int dim>
-  void Solver<dim>::compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k)
+  void Solver<dim>::compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k, bool viscosity)
   {
     const unsigned int n = s.size();
     resize(k, n);
@@ -107,11 +108,12 @@ namespace tribo::sph
 
     const BoundaryForce &bf        = prm.boundary;
     const double         bf_range2 = bf.range() * bf.range();
-    const double         alpha = prm.alpha, beta = prm.beta, eps = prm.av_epsilon;
+    const double         alpha = viscosity ? prm.alpha : 0.0, beta = viscosity ? prm.beta : 0.0;
+    const double         eps   = prm.av_epsilon;
     parallel_for(n, [&](unsigned int i) {
       Tensor<1, dim> acc, fb;
       Tensor<2, dim> L, M;
-      double         drho = 0, de = 0, max_mu = 0;
+      double         drho = 0, de = 0, heating = 0, max_mu = 0;
       for (unsigned int q = search.start[i]; q < search.start[i + 1]; ++q)
         {
           const unsigned int   j  = search.list[q];
@@ -147,6 +149,7 @@ namespace tribo::sph
           const SymmetricTensor<2, dim> pair = A[i] + A[j];
           acc += mj * (pair * g - Pi * g);
           de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);
+          heating += mj * 0.5 * Pi * dvg;
           L -= (mj / s.rho[j]) * dealii::outer_product(dv, g);
           M -= (mj / s.rho[j]) * dealii::outer_product(r, g);
         }
@@ -167,6 +170,7 @@ namespace tribo::sph
       k.boundary_force[i] = fb;
       k.drho[i]           = drho;
       k.de[i]             = de;
+      k.viscous_heating[i] = heating;
       k.dx[i]             = s.v[i];
       k.signal[i]         = c[i] * (1 + 1.2 * alpha) + beta * max_mu;
     });
@@ -182,6 +186,33 @@ namespace tribo::sph
         for (unsigned int c = 0; c < dim; ++c)
           if (iv.components & (1u << c))
             k.dv[i][c] = 0;
+  }
+
+  template <int dim>
+  void Solver<dim>::displace(const std::vector<unsigned int> &particles, const std::vector<Tensor<1, dim>> &dx)
+  {
+    if (particles.size() != dx.size())
+      throw std::logic_error("SPH displace: " + std::to_string(dx.size()) + " displacements for " +
+                             std::to_string(particles.size()) + " particles");
+    mid   = state;
+    mid.v.assign(state.size(), Tensor<1, dim>());
+    for (std::size_t q = 0; q < particles.size(); ++q)
+      mid.v[particles[q]] = dx[q];
+    Rates<dim> u;
+    compute_rates(mid, time, u, false);
+    parallel_for(state.size(), [&](unsigned int i) {
+      state.rho[i] += u.drho[i];
+      state.e[i] += u.de[i];
+      state.S[i] += u.dS[i];
+    });
+    for (std::size_t q = 0; q < particles.size(); ++q)
+      {
+        auto &x = state.x[particles[q]];
+        x += dx[q];
+        if (prm.period > 0)
+          x[0] -= prm.period * std::floor(x[0] / prm.period);
+      }
+    check_finite(state, "after a displacement");
   }
 
   template <int dim>
@@ -356,6 +387,10 @@ namespace tribo::sph
       if (prm.period > 0)
         state.x[i][0] -= prm.period * std::floor(state.x[i][0] / prm.period);
     });
+    double step_heat = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      step_heat += state.mass[i] * k2.viscous_heating[i];
+    heat += dt * step_heat;
     apply_damping(state, dt);
     time += dt;
     apply_imposed(state, time);
@@ -368,7 +403,7 @@ namespace tribo::sph
   {
     const auto &s = state;
     ar << s.x << s.v << s.mass << s.rho << s.e << s.S << s.h << s.material << s.body;
-    ar << time << damped_energy << limiter << std::size_t(damping.size());
+    ar << time << damped_energy << heat << limiter << std::size_t(damping.size());
     for (const Damping &d : damping)
       ar << d.body << d.gamma << d.relative_to_centre_of_mass << d.reference_velocity;
     ar << search.period << search.start << search.list << x_at_build << built_cutoff << builds;
@@ -384,7 +419,7 @@ namespace tribo::sph
       throw InputError("checkpoint: it holds " + std::to_string(s.size()) +
                        " SPH particles, this case builds " + std::to_string(n));
     std::size_t n_damping;
-    ar >> time >> damped_energy >> limiter >> n_damping;
+    ar >> time >> damped_energy >> heat >> limiter >> n_damping;
     damping.resize(n_damping);
     for (Damping &d : damping)
       ar >> d.body >> d.gamma >> d.relative_to_centre_of_mass >> d.reference_velocity;

@@ -101,6 +101,8 @@ namespace tribo::sph
     std::vector<Tensor<1, dim>> boundary_force; ///< force on i from other bodies, N
     std::vector<double>         pressure;       ///< P_i, Pa
     std::vector<double>         signal;         ///< c_i + 1.2 alpha c_i + beta max_j mu_ij, m/s
+    /// The artificial viscosity's share of de_i/dt, sum_j m_j Pi_ij/2 (v_i - v_j).grad_i W_ij, J/kg/s.
+    std::vector<double>         viscous_heating;
   };
 
   /// The solid SPH model and its integrator. Pairs of particles of the same body
@@ -152,8 +154,20 @@ namespace tribo::sph
     /// number of steps.
     unsigned int advance_to(double t_end);
 
-    /// Evaluates all rates at state @p s and time @p t into @p k.
-    void compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k);
+    /// Evaluates all rates at state @p s and time @p t into @p k. With @p viscosity
+    /// false the artificial viscosity is left out (Pi_ij = 0).
+    void compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k, bool viscosity = true);
+
+    /// Moves particles @p particles by @p dx (m) outside the integrator, as the velocity
+    /// field u (u_i = dx_i for the listed particles, 0 elsewhere) acting for unit time
+    /// does to first order: x_i += dx_i, and for every particle within reach
+    /// rho_i += sum_j m_j (u_i - u_j).grad_i W_ij, S_i += 2G (eps(u) - tr eps(u)/3 I) + the
+    /// Jaumann terms, e_i += sum_j m_j (u_j - u_i).(sigma_i / rho_i^2).grad_i W_ij (the
+    /// elastic work; no viscosity). So the density, the stress and the stored energy see
+    /// the motion: a coupling that corrects positions after a step (the Moreau-Jean
+    /// position term of a kicked contact particle) would otherwise compress the body
+    /// geometrically while its pressure stays, at the speed of the summed corrections.
+    void displace(const std::vector<unsigned int> &particles, const std::vector<Tensor<1, dim>> &dx);
     /// The largest stable step for rates @p k at state @p s, s; @p limiter is set
     /// to "CFL" or "acceleration" and @p worst to the particles with the smallest
     /// steps (up to 5, smallest first).
@@ -177,9 +191,13 @@ namespace tribo::sph
     double total_energy() const { return state.kinetic_energy() + state.internal_energy(); }
     /// Kinetic energy removed by the Damping terms since construction, J (>= 0).
     double damping_dissipation() const { return damped_energy; }
+    /// Heat the artificial viscosity has put into e since construction, J (>= 0):
+    /// sum over steps of dt sum_i m_i viscous_heating_i at the midpoint. It is part of
+    /// state.internal_energy(); the rest of that is the elastic work.
+    double viscous_heat() const { return heat; }
 
     /// Checkpoint: what a step carries to the next, bit for bit: the particle state, the
-    /// time, the damping terms (a scene may switch them), the damped energy, the last step's
+    /// time, the damping terms (a scene may switch them), the damped energy and viscous heat, the last step's
     /// limiter and the neighbour list with the positions it was built at (a list rebuilt at
     /// another time would sum the pairs in another order). The imposed velocities and
     /// external forces are the scene's, rebuilt with it; the step size is not carried (each
@@ -204,6 +222,7 @@ namespace tribo::sph
     ParticleState<dim>    mid;
     std::string           limiter;
     double                damped_energy = 0; ///< J, see damping_dissipation()
+    double                heat          = 0; ///< J, see viscous_heat()
     std::vector<Tensor<1, dim>> x_at_build;    ///< positions at the last list build, m
     double                      built_cutoff = 0; ///< the list's cut-off c (1 + skin), m
     unsigned long               builds = 0;

@@ -343,7 +343,8 @@ SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "ave
                    "normal_force_mean", "normal_force_target", "third_body_thickness",
                    "solid_fraction_mean", "cohesion_number", "mu_mean", "mu_std",
                    "power_lower_wall_mean", "power_upper_wall_mean", "power_dissipated_mean",
-                   "power_third_body_mean", "power_balance_ratio", "inertial_number",
+                   "power_third_body_mean", "power_balance_ratio", "energy_rate_mean",
+                   "power_balance_closure", "inertial_number",
                    "profile_samples_in_steady_state", "sigma_xx_mean", "sigma_yy_mean",
                    "sigma_xy_mean"]
 
@@ -657,6 +658,13 @@ class Sliding(ShearRun, unittest.TestCase):
         np.testing.assert_allclose(r["mu_std"], st["mu"][w].std(), rtol=1e-9)
         np.testing.assert_allclose(r["power_balance_ratio"], r["power_dissipated_mean"] / r["power_lower_wall_mean"],
                                    rtol=1e-12)
+        # The whole balance (rigid upper wall: the energy is the grains' kinetic energy).
+        tw, kw = st["time"][w], st["kinetic_energy"][w]
+        np.testing.assert_allclose(r["energy_rate_mean"], (kw[-1] - kw[0]) / (tw[-1] - tw[0]), rtol=1e-9)
+        np.testing.assert_allclose(r["power_balance_closure"],
+                                   (r["power_dissipated_mean"] + st["power_damping_upper_body"][w].mean() +
+                                    r["energy_rate_mean"]) / (r["power_lower_wall_mean"] + r["power_upper_wall_mean"]),
+                                   rtol=1e-9)
         d_grains = 2 * self.discs()["grains"].mean()
         np.testing.assert_allclose(r["inertial_number"],
                                    self.V / r["third_body_thickness"] * d_grains * math.sqrt(self.RHO / self.P),
