@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <sstream>
 
 namespace tribo::coupling
 {
@@ -92,6 +93,21 @@ namespace tribo::coupling
     time += step_h;
     for (unsigned int i = 0; i < chain.size(); ++i)
       start[i] = unwrapped(i);
+  }
+
+  std::string ParticleFirstBody::overlap_hint(double h) const
+  {
+    const double s      = prm.length / chain.size();
+    const double c      = p_wave_speed(prm);
+    const double h_safe = particle_coupling_courant * s / c;
+    std::ostringstream os;
+    os << "With an " << prm.model << " upper body a grain that passes one radius may have gone through "
+       << "its chain, whose particles are kicked once per contact step and give way in between: "
+       << "here c_p h / s = " << c * h / s << " (c_p = " << c << " m/s, s = " << s << " m)";
+    if (c * h / s > 0.5 * particle_coupling_courant)
+      os << "; a smaller Simulation/Time step holds them better (h = " << 0.5 * h_safe
+         << " s is half the coupling limit; docs/first_bodies.md)";
+    return os.str();
   }
 
   double ParticleFirstBody::mean_bottom_y() const

@@ -59,6 +59,9 @@ namespace tribo::coupling
     double kinetic_energy() const override;
     /// Sub-steps of the last predict().
     unsigned int last_substeps() const { return substeps; }
+    /// The chain's own limit: c_p h / s for this step, and the step that keeps it at
+    /// particle_coupling_courant.
+    std::string overlap_hint(double h) const override;
 
   protected:
     /// Engine hooks. Particle index p, all particles of the engine.

@@ -30,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include <string>
 #include <vector>
 
 namespace tribo::dem
@@ -70,6 +71,10 @@ namespace tribo::dem
     /// the position correction of an explicit particle body
     /// (coupling/particle_first_body.h). Booked with the contact power.
     virtual double impulse_extra_power() const { return 0; }
+    /// What the overlap guard adds to its message when a grain has passed more than its
+    /// radius into something while this body is attached and the contact step was @p h
+    /// (s): a body-specific cause and remedy, or nothing.
+    virtual std::string overlap_hint(double /*h*/) const { return {}; }
   };
 
   /// Placement and contacts of the half-disc elements on a BoundaryBody's chain.

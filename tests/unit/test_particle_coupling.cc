@@ -145,3 +145,29 @@ TEST(ParticleCoupling, MlpBodyOnGrainsKeepsItsThickness)
   EXPECT_LT(std::abs(run.integrator_loss), 0.1);
 }
 #endif
+
+#ifdef TRIBO_TEST_MLP
+TEST(ParticleCoupling, OverlapHintNamesTheChainsCourantNumber)
+{
+  // What the overlap guard adds for a particle body: its c_p h / s and a step that holds.
+  coupling::FirstBodyParameters p;
+  p.model = "mlp";
+  p.length = L;
+  p.thickness = 10 * s;
+  p.youngs_modulus = E;
+  p.poisson_ratio = nu;
+  p.density = rho;
+  p.resolution = s;
+  p.time_step = 2e-10;
+  p.pressure = P;
+  const auto   body = coupling::make_first_body(p);
+  const double c    = coupling::p_wave_speed(p); // 3922 m/s
+  EXPECT_NEAR(c, std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu) * rho)), 1e-9 * c);
+  const std::string hint = body->overlap_hint(2e-10);
+  EXPECT_NE(hint.find("With an mlp upper body a grain that passes one radius may have gone through its chain"),
+            std::string::npos) << hint;
+  EXPECT_NE(hint.find("here c_p h / s = 0.784465 (c_p = 3922.32 m/s, s = 1e-06 m)"), std::string::npos) << hint;
+  EXPECT_NE(hint.find("h = 1.27475e-10 s is half the coupling limit"), std::string::npos) << hint;
+  EXPECT_EQ(body->overlap_hint(2e-11).find("half the coupling limit"), std::string::npos);
+}
+#endif
