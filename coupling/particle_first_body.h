@@ -21,8 +21,8 @@
 /// work of the stresses on the displacement, sph::Solver::displace()), reported as
 /// impulse_extra_power() and booked with the contact power. An sph body whose density
 /// did not see the position term thinned geometrically at theta h P / (rho s) while its
-/// pressure stayed (0.50 m/s measured against 0.48 predicted on the unit test's column). With the sub-cycle's own energy error (RK2, Verlet) the
-/// body's balance then closes. A chain particle held up by a contact oscillates
+/// pressure stayed (0.50 m/s measured against 0.48 predicted on the unit test's column).
+/// With the sub-cycle's own energy error (RK2, Verlet) the body's balance then closes. A chain particle held up by a contact oscillates
 /// within a step (its neighbours accelerate it, the contact stops it): the contacts
 /// dissipate about (P s h)^2 / (2 m) per chain particle and step, a coupling loss
 /// that shrinks with h^2 / m (docs/first_bodies.md gives the measured figure).
@@ -59,8 +59,8 @@ namespace tribo::coupling
     double kinetic_energy() const override;
     /// Sub-steps of the last predict().
     unsigned int last_substeps() const { return substeps; }
-    /// The chain's own limit: c_p h / s for this step, and the step that keeps it at
-    /// particle_coupling_courant.
+    /// For the overlap guard: the chain's c_p h / s at step @p h (s) and, above half the
+    /// coupling limit, the step at half of it (particle_coupling_courant / 2).
     std::string overlap_hint(double h) const override;
 
   protected:

@@ -272,8 +272,8 @@ namespace tribo::dem
                 "solver's tolerance (high pressure: tighten Solver/Tolerance or Solver/Gap "
                 "tolerance, or set Contact law/Overlap recovery); with ELAS, a stiffness too low "
                 "for the load (docs/laws.md)";
-        if (boundary && !boundary->overlap_hint(h).empty())
-          os << ". " << boundary->overlap_hint(h);
+        if (const std::string hint = boundary ? boundary->overlap_hint(h) : std::string(); !hint.empty())
+          os << ". " << hint;
         throw RunError(os.str());
       }
     report.kinetic_energy = system.kinetic_energy();
