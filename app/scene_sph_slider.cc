@@ -719,6 +719,9 @@ namespace tribo::app
         res.set("n_contact_layer", long(contact.size()));
         res.set("n_driven", long(driven.size()));
         res.set("n_loaded", long(top.size()));
+        res.set("surface_height_rms", surface_rms);
+        res.set("surface_height_peak", surface_peak);
+        res.set("surface_holes", long(surface_removed));
       }
 
       /// The phase, the interval sums, the works and the unwrapped block displacements
@@ -754,14 +757,20 @@ namespace tribo::app
         return b;
       }
 
-      /// The substrate's points with the surface modifier applied to its top layer.
-      std::vector<Tensor<1, dim>> substrate_points(double a, Tensor<1, dim> &size) const
+      /// The substrate's points with the surface modifier applied to its top layer; keeps
+      /// the realised roughness (rms and peak height change of the top layer, holes made).
+      std::vector<Tensor<1, dim>> substrate_points(double a, Tensor<1, dim> &size)
       {
         size = box(p.substrate);
         if (p.periodic)
           size[0] = std::max(3.0, std::round(size[0] / a)) * a;
         auto         pts = sph::lattice_points<dim>(p.lattice, Tensor<1, dim>(), size, a);
         const double tol = 0.25 * layer_spacing(a);
+        const auto   top_layer = sph::surface_layer(pts, tol);
+        std::vector<double> z0;
+        for (unsigned int i : top_layer)
+          z0.push_back(pts[i][dim - 1]);
+        const std::size_t n_lattice = pts.size();
         switch (p.surface)
           {
             case Surface::step:
@@ -780,6 +789,19 @@ namespace tribo::app
             default:
               break;
           }
+        if (p.surface == Surface::random_heights || p.surface == Surface::fractal)
+          {
+            double sq = 0;
+            for (unsigned int k = 0; k < top_layer.size(); ++k)
+              {
+                const double dz = pts[top_layer[k]][dim - 1] - z0[k];
+                sq += dz * dz;
+                surface_peak = std::max(surface_peak, std::abs(dz));
+              }
+            surface_rms = std::sqrt(sq / top_layer.size());
+          }
+        if (p.surface == Surface::holes)
+          surface_removed = n_lattice - pts.size();
         return pts;
       }
 
@@ -976,6 +998,8 @@ namespace tribo::app
 
       SliderParameters            p;
       unsigned int                n_b = 0, n_s = 0, first_block = 0;
+      double                      surface_rms = 0, surface_peak = 0; ///< top-layer height change, m
+      std::size_t                 surface_removed = 0;               ///< holes made in the top layer
       std::vector<unsigned int>   fixed, top, contact, driven, block, region;
       std::vector<double>         sum_fx, sum_fn;
       std::vector<Tensor<1, dim>> v_top, x_block, displacement;

@@ -236,6 +236,48 @@ class Slider(unittest.TestCase):
         check_fields(self, self.high, s["n_particles"], s["n_field_snapshots"])
 
 
+class Surfaces(unittest.TestCase):
+    """The realised rough surfaces reported in summary.json (three 2 us runs, about 2 s)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        short = ["Simulation/End time=2e-6", "SPH slider/Slide start=1e-6", "SPH slider/Field interval=0"]
+        cls.jobs = {
+            "fractal": ["SPH slider/Surface=fractal", "SPH slider/Fractal dimension=1.3",
+                        "SPH slider/Roughness amplitude=1e-4"],
+            "random": ["SPH slider/Surface=random heights", "SPH slider/Roughness amplitude=2e-4"],
+            "holes": ["SPH slider/Surface=holes", "SPH slider/Hole fraction=0.3"]}
+        cls.dirs = {k: os.path.join(cls.tmp.name, k) for k in cls.jobs}
+        cls.procs = in_parallel([(cls.dirs[k], SLIDER, short + v) for k, v in cls.jobs.items()])
+        cls.results = {k: summary(d)["results"] for k, d in cls.dirs.items()}
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_fractal_has_the_requested_rms(self):
+        r = self.results["fractal"]
+        self.assertAlmostEqual(r["surface_height_rms"], 1e-4, delta=1e-12)
+        # A Gaussian-like surface of 16 points: its peak is 1.2-3 rms.
+        self.assertGreater(r["surface_height_peak"], 1.2e-4)
+        self.assertLess(r["surface_height_peak"], 3e-4)
+        self.assertEqual(r["surface_holes"], 0)
+
+    def test_uniform_heights_stay_within_half_the_width(self):
+        r = self.results["random"]
+        self.assertLessEqual(r["surface_height_peak"], 1e-4 * (1 + 1e-9))
+        # 16 draws of U(-dz/2, dz/2): rms dz/sqrt(12) = 5.8e-5, sampling spread ~ 20 %.
+        self.assertAlmostEqual(r["surface_height_rms"], 2e-4 / np.sqrt(12), delta=2.5e-5)
+
+    def test_holes_remove_the_rounded_fraction(self):
+        r = self.results["holes"]
+        # The 8 mm substrate's top layer holds 16 particles: round(0.3 x 16) = 5 removed.
+        self.assertEqual(r["surface_holes"], 5)
+        self.assertEqual(r["n_substrate"], 16 * 3 - 5)
+        self.assertEqual(r["surface_height_rms"], 0)
+
+
 class Stops(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
