@@ -114,6 +114,7 @@ namespace tribo::app
     {
       periodic,       ///< both lattices aligned and of the same spacing
       tilted,         ///< the block's lattice rotated in the x-vertical plane
+      twisted,        ///< 3D: the block's lattice rotated about the vertical axis
       incommensurate, ///< block spacing = ratio * substrate spacing
       step,           ///< one-particle step on the substrate beyond x_step
       holes,          ///< a fraction of the substrate's top particles removed
@@ -199,11 +200,14 @@ namespace tribo::app
                                "a ratio d/a in (0, 2)");
       const std::string surface = r.text(s + "Surface");
       const std::map<std::string, Surface> surfaces = {
-        {"periodic", Surface::periodic}, {"tilted", Surface::tilted},
+        {"periodic", Surface::periodic}, {"tilted", Surface::tilted}, {"twisted", Surface::twisted},
         {"incommensurate", Surface::incommensurate}, {"step", Surface::step},
         {"holes", Surface::holes}, {"random heights", Surface::random_heights},
         {"fractal", Surface::fractal}};
       p.surface = surfaces.at(surface);
+      if (p.surface == Surface::twisted && p.dim != 3)
+        r.fail(s + "Surface", "'twisted' only with Dimension = 3 (a rotation about the vertical axis; in 2D use "
+                              "'tilted')");
       p.angle   = r.number(s + "Tilt angle", [](double v) { return v >= 0 && v <= 45; },
                            "an angle in degrees in [0, 45]") * M_PI / 180;
       p.ratio   = r.number(s + "Mesh ratio", positive, "a positive ratio (golden mean 1.618...)");
@@ -805,22 +809,24 @@ namespace tribo::app
         return pts;
       }
 
-      /// The block's points (origin 0): a box lattice, or for Surface = tilted a lattice
-      /// rotated by the tilt angle about the box centre and cut to the box.
+      /// The block's points (origin 0): a box lattice, or for Surface = tilted (twisted) a
+      /// lattice rotated by the tilt angle about the box centre in the x-vertical (x-y)
+      /// plane and cut to the box.
       std::vector<Tensor<1, dim>> block_points(double a) const
       {
         const Tensor<1, dim> size = box(p.block);
-        if (p.surface != Surface::tilted)
+        if (p.surface != Surface::tilted && p.surface != Surface::twisted)
           return sph::lattice_points<dim>(p.lattice, Tensor<1, dim>(), size, a);
-        const double   diag = size.norm();
-        Tensor<1, dim> big_origin, big;
-        for (unsigned int d = 0; d < dim; ++d)
+        const unsigned int axis = p.surface == Surface::tilted ? dim - 1 : 1;
+        const double       diag = size.norm();
+        Tensor<1, dim>     big_origin, big = size;
+        for (unsigned int d : {0U, axis})
           {
-            big[d]        = d == 1 && dim == 3 ? size[d] : size[d] + 2 * diag;
-            big_origin[d] = d == 1 && dim == 3 ? 0 : -diag;
+            big[d]        = size[d] + 2 * diag;
+            big_origin[d] = -diag;
           }
         auto pts = sph::lattice_points<dim>(p.lattice, big_origin, big, a);
-        sph::tilt(pts, size / 2, p.angle);
+        sph::tilt(pts, size / 2, p.angle, axis);
         std::vector<Tensor<1, dim>> kept;
         for (const auto &x : pts)
           {
@@ -1248,13 +1254,15 @@ namespace tribo::app
     prm.declare_entry("Boundary range ratio", "1", Double(),
                       "Range d of f1 as a fraction of a, in (0, 2); the block starts a distance d above the substrate.");
     prm.declare_entry("Surface", "periodic",
-                      Selection("periodic|tilted|incommensurate|step|holes|random heights|fractal"),
-                      "Contact surfaces: 'periodic' (aligned lattices), 'tilted' (block lattice rotated by Tilt angle), "
+                      Selection("periodic|tilted|twisted|incommensurate|step|holes|random heights|fractal"),
+                      "Contact surfaces: 'periodic' (aligned lattices), 'tilted' (block lattice rotated by Tilt angle "
+                      "in the x-vertical plane: a stepped contact face), 'twisted' (3D: rotated by Tilt angle about "
+                      "the vertical axis, flat faces, the rows crossing the substrate's at that angle), "
                       "'incommensurate' (block spacing = Mesh ratio x a), 'step' (one-particle step on the substrate "
                       "beyond Step position), 'holes' (Hole fraction of the substrate's top layer removed), "
                       "'random heights' (substrate top moved uniformly in +/- dz/2), 'fractal' (self-affine "
                       "substrate top of dimension D_f, rms height dz).");
-    prm.declare_entry("Tilt angle", "10", Double(), "Tilt of the block's lattice in the x-vertical plane, degrees, [0, 45].");
+    prm.declare_entry("Tilt angle", "10", Double(), "Rotation of the block's lattice for 'tilted' and 'twisted', degrees, [0, 45].");
     prm.declare_entry("Mesh ratio", "1.618033988749895", Double(),
                       "Block spacing / substrate spacing for 'incommensurate' (> 0, != 1; golden mean by default).");
     prm.declare_entry("Hole fraction", "0.3", Double(), "Fraction of the substrate's top particles removed, [0, 1).");

@@ -86,9 +86,12 @@ namespace tribo::sph
   }
 
   template <int dim>
-  void tilt(std::vector<Tensor<1, dim>> &points, const Tensor<1, dim> &centre, double angle)
+  void tilt(std::vector<Tensor<1, dim>> &points, const Tensor<1, dim> &centre, double angle,
+            unsigned int axis)
   {
-    const unsigned int v = dim - 1;
+    AssertIndexRange(axis, dim);
+    Assert(axis > 0, ExcMessage("tilt: the rotation plane is x and a second axis"));
+    const unsigned int v = axis;
     const double       c = std::cos(angle), s = std::sin(angle);
     for (auto &p : points)
       {
@@ -223,7 +226,8 @@ namespace tribo::sph
   template std::vector<Tensor<1, dim>> lattice_points<dim>(LatticeType, const Tensor<1, dim> &,   \
                                                            const Tensor<1, dim> &, double);       \
   template double volume_per_particle<dim>(LatticeType, double);                                  \
-  template void   tilt<dim>(std::vector<Tensor<1, dim>> &, const Tensor<1, dim> &, double);       \
+  template void   tilt<dim>(std::vector<Tensor<1, dim>> &, const Tensor<1, dim> &, double,        \
+                                   unsigned int);                                               \
   template std::vector<unsigned int> surface_layer<dim>(const std::vector<Tensor<1, dim>> &,      \
                                                         double, bool);                            \
   template void add_step<dim>(std::vector<Tensor<1, dim>> &, double, double, double);             \

@@ -38,9 +38,12 @@ namespace tribo::sph
   template <int dim>
   double volume_per_particle(LatticeType type, double a);
 
-  /// Rotates @p points by @p angle about @p centre in the x-vertical plane.
+  /// Rotates @p points by @p angle (rad, from x towards @p axis) about @p centre in the
+  /// plane of x and @p axis: the vertical (dim - 1, a tilt) or, in 3D, y (1, a twist
+  /// about the vertical axis).
   template <int dim>
-  void tilt(std::vector<Tensor<1, dim>> &points, const Tensor<1, dim> &centre, double angle);
+  void tilt(std::vector<Tensor<1, dim>> &points, const Tensor<1, dim> &centre, double angle,
+            unsigned int axis = dim - 1);
 
   /// Indices of the particles within @p tol (m) of the top (largest vertical
   /// coordinate; @p top = false: bottom) of @p points.

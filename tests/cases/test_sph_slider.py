@@ -368,6 +368,12 @@ class BadInput(unittest.TestCase):
         self.assertEqual(p.returncode, 2)
         self.assertIn("SPH slider/Surface=wavy", p.stderr)
 
+    def test_twist_needs_3d(self):
+        p = run(self.dir, SLIDER, "SPH slider/Surface=twisted")
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("error: --set: entry 'SPH slider/Surface' = 'twisted': expected 'twisted' only with "
+                      "Dimension = 3 (a rotation about the vertical axis; in 2D use 'tilted')", p.stderr)
+
 
 if __name__ == "__main__":
     TRIBO = os.path.abspath(sys.argv.pop(1))

@@ -280,6 +280,15 @@ TEST(SphLattice, SpacingVolumeAndSurfaceModifiers)
   tilt(tilted, vec<2>(0, 0), 0.3);
   EXPECT_NEAR(tilted[5].norm(), pts[5].norm(), 1e-15);
   EXPECT_NEAR(std::atan2(tilted[5][1], tilted[5][0]) - std::atan2(pts[5][1], pts[5][0]), 0.3, 1e-12);
+  // A twist about the vertical axis (3D, plane x-y) keeps the heights: a flat face stays flat.
+  std::vector<Tensor<1, 3>> column = {vec<3>(2 * a, 0, 5 * a), vec<3>(3 * a, a, 5 * a)};
+  tilt(column, vec<3>(a, 0, 0), M_PI / 2, 1);
+  EXPECT_NEAR(column[0][0], a, 1e-15);
+  EXPECT_NEAR(column[0][1], a, 1e-15);
+  EXPECT_NEAR(column[1][0], 0, 1e-15);
+  EXPECT_NEAR(column[1][1], 2 * a, 1e-15);
+  EXPECT_EQ(column[0][2], 5 * a);
+  EXPECT_EQ(column[1][2], 5 * a);
 }
 
 // ---------------------------------------------------------------- SPH interpolation
