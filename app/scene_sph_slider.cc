@@ -723,6 +723,7 @@ namespace tribo::app
         res.set("n_contact_layer", long(contact.size()));
         res.set("n_driven", long(driven.size()));
         res.set("n_loaded", long(top.size()));
+        res.set("n_fixed", long(fixed.size()));
         res.set("surface_height_rms", surface_rms);
         res.set("surface_height_peak", surface_peak);
         res.set("surface_holes", long(surface_removed));
@@ -774,6 +775,7 @@ namespace tribo::app
         std::vector<double> z0;
         for (unsigned int i : top_layer)
           z0.push_back(pts[i][dim - 1]);
+        single_layer = top_layer.size() == pts.size();
         const std::size_t n_lattice = pts.size();
         switch (p.surface)
           {
@@ -924,8 +926,14 @@ namespace tribo::app
 
         // Groups (indices into the state).
         const double lb = layer_spacing(a_b), tol_b = p.surface == Surface::tilted ? 0.6 * a_b : 0.25 * lb;
-        for (unsigned int i : sph::surface_layer(sub, 0.25 * layer_spacing(a_s), false))
-          fixed.push_back(i);
+        // The bottom layer is fixed; a single-layer substrate is rigid (all fixed), as the
+        // paper's random and fractal substrates (its section 4.3).
+        if (single_layer)
+          for (unsigned int i = 0; i < sub.size(); ++i)
+            fixed.push_back(i);
+        else
+          for (unsigned int i : sph::surface_layer(sub, 0.25 * layer_spacing(a_s), false))
+            fixed.push_back(i);
         for (unsigned int i : sph::surface_layer(blk, tol_b, true))
           top.push_back(first + i);
         for (unsigned int i : sph::surface_layer(blk, tol_b, false))
@@ -1006,6 +1014,7 @@ namespace tribo::app
       unsigned int                n_b = 0, n_s = 0, first_block = 0;
       double                      surface_rms = 0, surface_peak = 0; ///< top-layer height change, m
       std::size_t                 surface_removed = 0;               ///< holes made in the top layer
+      bool                        single_layer = false;              ///< one-layer (rigid) substrate
       std::vector<unsigned int>   fixed, top, contact, driven, block, region;
       std::vector<double>         sum_fx, sum_fn;
       std::vector<Tensor<1, dim>> v_top, x_block, displacement;

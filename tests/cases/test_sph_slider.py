@@ -237,7 +237,7 @@ class Slider(unittest.TestCase):
 
 
 class Surfaces(unittest.TestCase):
-    """The realised rough surfaces reported in summary.json (three 2 us runs, about 2 s)."""
+    """The realised rough surfaces reported in summary.json (four 2 us runs, about 2 s)."""
 
     @classmethod
     def setUpClass(cls):
@@ -247,7 +247,9 @@ class Surfaces(unittest.TestCase):
             "fractal": ["SPH slider/Surface=fractal", "SPH slider/Fractal dimension=1.3",
                         "SPH slider/Roughness amplitude=1e-4"],
             "random": ["SPH slider/Surface=random heights", "SPH slider/Roughness amplitude=2e-4"],
-            "holes": ["SPH slider/Surface=holes", "SPH slider/Hole fraction=0.3"]}
+            "holes": ["SPH slider/Surface=holes", "SPH slider/Hole fraction=0.3"],
+            "one_layer": ["SPH slider/Surface=random heights", "SPH slider/Roughness amplitude=2e-4",
+                          "SPH slider/Substrate size=8e-3, 1, 5e-4"]}
         cls.dirs = {k: os.path.join(cls.tmp.name, k) for k in cls.jobs}
         cls.procs = in_parallel([(cls.dirs[k], SLIDER, short + v) for k, v in cls.jobs.items()])
         cls.results = {k: summary(d)["results"] for k, d in cls.dirs.items()}
@@ -276,6 +278,13 @@ class Surfaces(unittest.TestCase):
         self.assertEqual(r["surface_holes"], 5)
         self.assertEqual(r["n_substrate"], 16 * 3 - 5)
         self.assertEqual(r["surface_height_rms"], 0)
+        self.assertEqual(r["n_fixed"], 16)  # the bottom layer
+
+    def test_one_layer_substrate_is_rigid(self):
+        r = self.results["one_layer"]
+        self.assertEqual(r["n_substrate"], 16)
+        self.assertEqual(r["n_fixed"], 16)
+        self.assertGreater(r["surface_height_peak"], 0)
 
 
 class Stops(unittest.TestCase):
