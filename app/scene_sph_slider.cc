@@ -1278,7 +1278,10 @@ namespace tribo::app
     prm.declare_entry("Roughness amplitude", "1.5e-4", Double(),
                       "dz, m (>= 0): full width of the uniform heights, or rms of the fractal heights.");
     prm.declare_entry("Fractal dimension", "2.5", Double(), "D_f of the fractal substrate, in (dim - 1, dim).");
-    prm.declare_entry("Step position", "6e-3", Double(), "x beyond which the substrate is one layer higher, m (>= 0).");
+    prm.declare_entry("Step position", "6e-3", Double(),
+                      "x beyond which the substrate is one layer higher, m (>= 0). The block rests centred, its "
+                      "front at (Lx_substrate + Lx_block)/2 (7.5e-3 m in paper.prm): put the step ahead of it for "
+                      "the block to run into it.");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the random surfaces, >= 0.");
     prm.declare_entry("Local friction regions", "4", Integer(1),
                       "Number of equal groups (by initial x) of the contact layer with their own mu, >= 1.");
