@@ -181,11 +181,15 @@ namespace tribo::sph
         for (unsigned int i : ef.particles)
           k.dv[i] += (ramp / s.mass[i]) * ef.force;
       }
-    for (const auto &iv : imposed)
-      for (unsigned int i : iv.particles)
+    k.imposed_force.assign(imposed.size(), Tensor<1, dim>());
+    for (unsigned int e = 0; e < imposed.size(); ++e)
+      for (unsigned int i : imposed[e].particles)
         for (unsigned int c = 0; c < dim; ++c)
-          if (iv.components & (1u << c))
-            k.dv[i][c] = 0;
+          if (imposed[e].components & (1u << c))
+            {
+              k.imposed_force[e][c] -= s.mass[i] * k.dv[i][c];
+              k.dv[i][c] = 0;
+            }
   }
 
   template <int dim>
@@ -249,15 +253,19 @@ namespace tribo::sph
   }
 
   template <int dim>
-  void Solver<dim>::apply_imposed(ParticleState<dim> &s, double t) const
+  void Solver<dim>::apply_imposed(ParticleState<dim> &s, double t, bool count)
   {
-    for (const auto &iv : imposed)
+    for (auto &iv : imposed)
       for (unsigned int i : iv.particles)
         {
           const Tensor<1, dim> v = iv.field ? iv.field(s.x[i], t) : iv.velocity;
           for (unsigned int c = 0; c < dim; ++c)
             if (iv.components & (1u << c))
-              s.v[i][c] = v[c];
+              {
+                if (count)
+                  iv.impulse[c] += s.mass[i] * (v[c] - s.v[i][c]);
+                s.v[i][c] = v[c];
+              }
         }
   }
 
@@ -391,9 +399,11 @@ namespace tribo::sph
     for (unsigned int i = 0; i < n; ++i)
       step_heat += state.mass[i] * k2.viscous_heating[i];
     heat += dt * step_heat;
+    for (unsigned int e = 0; e < imposed.size(); ++e)
+      imposed[e].impulse += dt * k2.imposed_force[e];
     apply_damping(state, dt);
     time += dt;
-    apply_imposed(state, time);
+    apply_imposed(state, time, true);
     check_finite(state, "after the step");
     return dt;
   }

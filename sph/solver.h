@@ -58,6 +58,11 @@ namespace tribo::sph
     Tensor<1, dim>            velocity; ///< m/s
     unsigned int              components = (1u << dim) - 1; ///< imposed components (bit mask)
     std::function<Tensor<1, dim>(const Tensor<1, dim> &x, double t)> field;
+    /// Impulse the constraint has supplied (N s; N s/m in 2D), summed over steps: dt times
+    /// its force at the step's midpoint (Rates::imposed_force) plus the velocity reset
+    /// sum m (v_imposed - v) at the end of each step (e.g. of the damping). The owner
+    /// reads and clears it.
+    Tensor<1, dim> impulse;
   };
 
   /// An external force on each listed particle, ramped in time:
@@ -103,6 +108,9 @@ namespace tribo::sph
     std::vector<double>         signal;         ///< c_i + 1.2 alpha c_i + beta max_j mu_ij, m/s
     /// The artificial viscosity's share of de_i/dt, sum_j m_j Pi_ij/2 (v_i - v_j).grad_i W_ij, J/kg/s.
     std::vector<double>         viscous_heating;
+    /// Per Solver::imposed entry, the force its constraint supplies, -sum_i m_i dv_i over
+    /// the imposed components (before they are zeroed), N (N/m in 2D).
+    std::vector<Tensor<1, dim>> imposed_force;
   };
 
   /// The solid SPH model and its integrator. Pairs of particles of the same body
@@ -211,7 +219,9 @@ namespace tribo::sph
     std::string describe_particle(const ParticleState<dim> &s, unsigned int i) const;
 
   private:
-    void apply_imposed(ParticleState<dim> &s, double t) const;
+    /// Sets the imposed velocity components; with @p count, adds the reset's impulse
+    /// sum m (v_imposed - v) to each entry's ImposedVelocity::impulse.
+    void apply_imposed(ParticleState<dim> &s, double t, bool count = false);
     void apply_damping(ParticleState<dim> &s, double dt);
     void check_finite(const ParticleState<dim> &s, const std::string &where) const;
 

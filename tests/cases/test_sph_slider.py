@@ -5,9 +5,12 @@
    omega^2 = E H^2 k^4 / (12 rho (1 - nu^2)), kL = 1.875: the SPH frequency converges to it
    at first order in a/H (measured 0.746 at H = 4a, 0.836 at H = 6a, 0.871 at 8a, 0.896 at
    10a, i.e. about 1 - a/H); the linear extrapolation from H = 4a and 6a must be within 4 %;
-2. the 2D slider at 1e6 Pa has no measurable friction over a whole lattice period (0.007),
-   at 1e8 Pa and 1 m/s mu is clearly non-zero (0.06, the paper's value), and in the sliding phase the normal force on
-   the block's contact layer is P A within 3 % and the drive balances the friction;
+2. the 2D slider at 1e6 Pa has no measurable friction over a whole lattice period (0.006);
+   friction needs dissipation: at 1e8 Pa and 1 m/s it is 0.001 with gamma = 1e6 1/s and
+   0.027 with gamma = 1e8 1/s, and the drive's work over whole periods is mu F_n V;
+   in the sliding phase the normal force on the block's contact layer is P A within 3 %
+   and the drive balances the friction; at 0.1 m/s the block follows the drive (it tore
+   under the driven layers at V/2 when the drive was imposed between steps only);
 3. SIGTERM ends a run with status "interrupted", exit 143 and consistent, complete files;
    a step floor above the stable step ends it with status "failed", exit 1;
 4. bad entries give exit 2 and an exact message.
@@ -146,25 +149,33 @@ class Plate(unittest.TestCase):
 
 
 class Slider(unittest.TestCase):
-    """The slider at 1e6 and 1e8 Pa, 1 m/s, two lattice periods (about 20 s together)."""
+    """The slider at 1e6 and 1e8 Pa, 1 m/s, two lattice periods, at 1e8 Pa also with
+    gamma = 1e8 1/s and at 0.1 m/s (about 30 s together)."""
 
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.low = os.path.join(cls.tmp.name, "low")
         cls.high = os.path.join(cls.tmp.name, "high")
+        cls.damped = os.path.join(cls.tmp.name, "damped")
+        cls.slow = os.path.join(cls.tmp.name, "slow")
         cls.procs = in_parallel([(cls.low, SLIDER, ["SPH slider/Pressure=1e6"]),
-                                 (cls.high, SLIDER, ["SPH slider/Pressure=1e8"])])
+                                 (cls.high, SLIDER, ["SPH slider/Pressure=1e8"]),
+                                 (cls.damped, SLIDER, ["SPH slider/Gamma=1e8"]),
+                                 (cls.slow, SLIDER, ["SPH slider/Sliding velocity=0.1",
+                                                     "SPH slider/Field interval=0"])])
         cls.s_low, cls.s_high = summary(cls.low), summary(cls.high)
+        cls.s_damped, cls.s_slow = summary(cls.damped), summary(cls.slow)
 
     @classmethod
     def tearDownClass(cls):
         cls.tmp.cleanup()
 
     def test_runs_complete(self):
-        for p, s in zip(self.procs, (self.s_low, self.s_high)):
+        for p, s in zip(self.procs, (self.s_low, self.s_high, self.s_damped, self.s_slow)):
             self.assertEqual(p.returncode, 0, p.stderr)
             self.assertEqual(s["status"], "complete")
+        for s in (self.s_low, self.s_high, self.s_damped):
             self.assertEqual(s["results"]["window_lattice_periods"], 1)
 
     def test_no_measurable_friction_at_low_pressure(self):
@@ -174,13 +185,21 @@ class Slider(unittest.TestCase):
         # The block still climbs over the substrate's particles: large but reversible mu(t).
         self.assertGreater(r["mu_std"], 0.1)
 
-    def test_friction_at_1e8_pa(self):
-        r = self.s_high["results"]
-        print("\nmu at 1e8 Pa: %.4f (std %.3f)" % (r["mu_mean"], r["mu_std"]))
-        # Measured 0.057 (quick.prm, the paper: 0.06); 1e6 Pa gives 0.007.
-        self.assertGreater(r["mu_mean"], 0.035)
-        self.assertLess(r["mu_mean"], 0.15)
-        self.assertGreater(r["mu_mean"], 3 * abs(self.s_low["results"]["mu_mean"]))
+    def test_friction_needs_dissipation(self):
+        mu_weak = self.s_high["results"]["mu_mean"]
+        mu_damped = self.s_damped["results"]["mu_mean"]
+        print("\nmu at 1e8 Pa: %.4f (gamma 1e6), %.4f (gamma 1e8)" % (mu_weak, mu_damped))
+        # Measured 0.0012 and 0.027 (the paper: 0.06 at 1e6 and 1e8, docs/validation.md).
+        self.assertLess(abs(mu_weak), 0.01)
+        self.assertGreater(mu_damped, 0.015)
+        self.assertGreater(mu_damped, 5 * abs(mu_weak))
+
+    def test_block_follows_the_drive_slowly(self):
+        # At 0.1 m/s the block has to climb out of the substrate's valleys quasi-statically
+        # (mu up to ~0.6); with the drive imposed between steps only, its lower layers
+        # stayed put and the centre of mass moved at V/2.
+        r = self.s_slow["results"]
+        self.assertAlmostEqual(r["block_vx_mean"] / r["sliding_velocity"], 1.0, delta=0.05)
 
     def test_normal_force_is_pressure_times_area(self):
         for s in (self.s_low, self.s_high):
@@ -191,7 +210,7 @@ class Slider(unittest.TestCase):
     def test_drive_balances_friction(self):
         # Damping relative to each body's centre of mass exerts no net force: over whole
         # lattice periods the imposed drive balances the contact force.
-        r = self.s_high["results"]
+        r = self.s_damped["results"]
         self.assertAlmostEqual(r["drive_force_mean"], -r["tangential_force_mean"],
                                delta=0.05 * abs(r["tangential_force_mean"]))
         # With two driven layers the block follows the drive.
@@ -199,9 +218,9 @@ class Slider(unittest.TestCase):
 
     def test_energy_balance_over_whole_periods(self):
         # Over the window (whole lattice periods) the kinetic energy returns to its value
-        # and the drive's power is mu F_n V: at 1e8 Pa it is dissipated (damping, the
-        # drive's velocity resets, artificial viscosity), at 1e6 Pa hardly any is.
-        for s, d in ((self.s_high, self.high), (self.s_low, self.low)):
+        # and the drive's power is mu F_n V: at 1e8 Pa with gamma = 1e8 it is dissipated
+        # (damping, artificial viscosity), at 1e6 Pa hardly any is.
+        for s, d in ((self.s_damped, self.damped), (self.s_low, self.low)):
             st = statistics(d)
             r = s["results"]
             i0 = int(np.nonzero(st["time"] <= r["window_start"] + 1e-12)[0][-1])
@@ -210,7 +229,7 @@ class Slider(unittest.TestCase):
             fv = r["normal_force_mean"] * r["sliding_velocity"]
             work_in = delta["work_drive"] + delta["work_pressure"]
             kinetic = delta["kinetic_energy_block"] + delta["kinetic_energy_substrate"]
-            if s is self.s_high:
+            if s is self.s_damped:
                 self.assertAlmostEqual(delta["work_drive"] / span / (r["mu_mean"] * fv), 1.0, delta=0.03)
                 self.assertLess(abs(kinetic), 0.02 * work_in)
                 self.assertGreater(delta["energy_residual"] + delta["internal_energy"], 0.9 * work_in)
