@@ -1258,9 +1258,8 @@ namespace tribo::app
                       "and holds it vertically). Before sliding both bodies are damped toward rest.");
     prm.declare_entry("Driven layers", "2", Integer(1),
                       "Number of top layers of the block whose horizontal velocity is imposed (vertical free), >= 1. "
-                      "The paper drives the first and sometimes the second layer; with one driven layer the "
-                      "SPH block lags ever more behind it at 1e8 Pa (the driven layer shears through the "
-                      "block), with two it follows (docs/validation.md).");
+                      "The paper drives the first and sometimes the second layer; the block follows either "
+                      "(2D quick case: mu 0.0025 with one, 0.0012 with two; docs/validation.md).");
     prm.declare_entry("Artificial viscosity alpha", "1", Double(), "Monaghan viscosity alpha, >= 0.");
     prm.declare_entry("Artificial viscosity beta", "0.1", Double(), "Monaghan viscosity beta, >= 0.");
     prm.declare_entry("CFL number", "0.3", Double(), "C in dt = C h/(c (1 + 1.2 alpha) + beta max mu), in (0, 1].");
