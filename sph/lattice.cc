@@ -227,7 +227,7 @@ namespace tribo::sph
                                                            const Tensor<1, dim> &, double);       \
   template double volume_per_particle<dim>(LatticeType, double);                                  \
   template void   tilt<dim>(std::vector<Tensor<1, dim>> &, const Tensor<1, dim> &, double,        \
-                                   unsigned int);                                               \
+                            unsigned int);                                                        \
   template std::vector<unsigned int> surface_layer<dim>(const std::vector<Tensor<1, dim>> &,      \
                                                         double, bool);                            \
   template void add_step<dim>(std::vector<Tensor<1, dim>> &, double, double, double);             \
