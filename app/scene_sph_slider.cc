@@ -137,6 +137,7 @@ namespace tribo::app
       unsigned int          driven_layers = 1;
       double                alpha = 1, beta = 0.1, courant = 0.3, dt_min = 0;
       double                stiffness_factor = 1, range_ratio = 1;
+      bool                  rest_on_tips = false;
       Surface               surface = Surface::periodic;
       double                angle = 0, ratio = 1, hole_fraction = 0, dz = 0, fractal_dimension = 2.5;
       double                step_position = 0;
@@ -198,6 +199,7 @@ namespace tribo::app
       p.stiffness_factor = r.number(s + "Boundary stiffness factor", positive, "a positive factor");
       p.range_ratio = r.number(s + "Boundary range ratio", [](double v) { return v > 0 && v < 2; },
                                "a ratio d/a in (0, 2)");
+      p.rest_on_tips = r.text(s + "Block rest") == "tips";
       const std::string surface = r.text(s + "Surface");
       const std::map<std::string, Surface> surfaces = {
         {"periodic", Surface::periodic}, {"tilted", Surface::tilted}, {"twisted", Surface::twisted},
@@ -719,6 +721,7 @@ namespace tribo::app
         res.set("surface_height_rms", surface_rms);
         res.set("surface_height_peak", surface_peak);
         res.set("surface_holes", long(surface_removed));
+        res.set("rest_gap", rest_gap);
       }
 
       /// The phase, the interval sums, the works and the unwrapped block displacements
@@ -833,10 +836,11 @@ namespace tribo::app
         return kept;
       }
 
-      /// The block's rest position: shift = centre + o + z e_vertical where the horizontal
-      /// offset o (a grid of 8 per axis over one spacing @p a) lets the block sit lowest
-      /// with every block-substrate distance >= d, the range of f1 (the valleys of the
-      /// substrate, zero force). For a pair at horizontal distance rho < d the block's
+      /// The block's rest position: shift = centre + o + z e_vertical where z is the lowest
+      /// height with every block-substrate distance >= d, the range of f1 (zero force), and
+      /// the horizontal offset o (a grid of 8 per axis over one spacing @p a) makes z lowest
+      /// (Block rest = valleys) or highest (tips: the lattices stacked, each contact particle
+      /// d above a substrate particle). For a pair at horizontal distance rho < d the block's
       /// particle may come down to z_j + sqrt(d^2 - rho^2); @p period > 0: x periodic.
       Tensor<1, dim> placement(const std::vector<Tensor<1, dim>> &sub, const std::vector<Tensor<1, dim>> &blk,
                                const Tensor<1, dim> &centre, double a, double period) const
@@ -856,7 +860,8 @@ namespace tribo::app
             near_blk.push_back(x);
         const unsigned int n_grid = 8;
         Tensor<1, dim>     best;
-        best[dim - 1] = 1e300;
+        const double       sign = p.rest_on_tips ? -1 : 1; // minimise sign z
+        best[dim - 1] = sign * 1e300;
         for (unsigned int gx = 0; gx < n_grid; ++gx)
           for (unsigned int gy = 0; gy < (dim == 3 ? n_grid : 1U); ++gy)
             {
@@ -877,7 +882,7 @@ namespace tribo::app
                     if (rho2 < d * d)
                       z = std::max(z, xs[dim - 1] + std::sqrt(d * d - rho2) - xb[dim - 1]);
                   }
-              if (z < best[dim - 1] - 1e-12 * a)
+              if (sign * z < sign * best[dim - 1] - 1e-12 * a)
                 {
                   best          = shift;
                   best[dim - 1] = z;
@@ -906,6 +911,12 @@ namespace tribo::app
         const Tensor<1, dim> shift = placement(sub, blk, centre, a_s, p.periodic ? sub_size[0] : 0.0);
         for (auto &x : blk)
           x += shift;
+        double sub_top = -1e300, blk_bottom = 1e300;
+        for (const auto &x : sub)
+          sub_top = std::max(sub_top, x[dim - 1]);
+        for (const auto &x : blk)
+          blk_bottom = std::min(blk_bottom, x[dim - 1]);
+        rest_gap = blk_bottom - sub_top;
 
         const auto &m = p.material;
         n_s = sub.size();
@@ -1022,6 +1033,7 @@ namespace tribo::app
       unsigned int                n_b = 0, n_s = 0, first_block = 0;
       double                      surface_rms = 0, surface_peak = 0; ///< top-layer height change, m
       std::size_t                 surface_removed = 0;               ///< holes made in the top layer
+      double                      rest_gap = 0; ///< block's lowest minus substrate's highest z at t = 0, m
       bool                        single_layer = false;              ///< one-layer (rigid) substrate
       std::vector<unsigned int>   fixed, top, contact, driven, block, region;
       std::vector<double>         sum_fx, sum_fn;
@@ -1270,6 +1282,11 @@ namespace tribo::app
                       "of depth in 2D; the paper's K ~ E h estimate), > 0.");
     prm.declare_entry("Boundary range ratio", "1", Double(),
                       "Range d of f1 as a fraction of a, in (0, 2); the block starts a distance d above the substrate.");
+    prm.declare_entry("Block rest", "valleys", Selection("valleys|tips"),
+                      "Where the block starts, each contact particle at the distance d of f1 from the substrate: "
+                      "'valleys' (lowest, the block's lattice shifted horizontally into the substrate's hollows) "
+                      "or 'tips' (the lattices stacked, each contact particle d above a substrate particle, the "
+                      "paper's 'at a distance equal to the inter-particle spacing'; an unstable rest).");
     prm.declare_entry("Surface", "periodic",
                       Selection("periodic|tilted|twisted|incommensurate|step|holes|random heights|fractal"),
                       "Contact surfaces: 'periodic' (aligned lattices), 'tilted' (block lattice rotated by Tilt angle "

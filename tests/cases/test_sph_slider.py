@@ -256,7 +256,7 @@ class Slider(unittest.TestCase):
 
 
 class Surfaces(unittest.TestCase):
-    """The realised rough surfaces reported in summary.json (four 2 us runs, about 2 s)."""
+    """The realised rough surfaces and rest heights reported in summary.json (six 2 us runs, about 3 s)."""
 
     @classmethod
     def setUpClass(cls):
@@ -267,6 +267,8 @@ class Surfaces(unittest.TestCase):
                         "SPH slider/Roughness amplitude=1e-4"],
             "random": ["SPH slider/Surface=random heights", "SPH slider/Roughness amplitude=2e-4"],
             "holes": ["SPH slider/Surface=holes", "SPH slider/Hole fraction=0.3"],
+            "valleys": [],
+            "tips": ["SPH slider/Block rest=tips"],
             "one_layer": ["SPH slider/Surface=random heights", "SPH slider/Roughness amplitude=2e-4",
                           "SPH slider/Substrate size=8e-3, 1, 5e-4"]}
         cls.dirs = {k: os.path.join(cls.tmp.name, k) for k in cls.jobs}
@@ -298,6 +300,13 @@ class Surfaces(unittest.TestCase):
         self.assertEqual(r["n_substrate"], 16 * 3 - 5)
         self.assertEqual(r["surface_height_rms"], 0)
         self.assertEqual(r["n_fixed"], 16)  # the bottom layer
+
+    def test_rest_in_the_valleys_or_on_the_tips(self):
+        # f1's range d = a = 5e-4 m; 2D aligned lattices. In a valley the block's particle
+        # is a/2 from two substrate particles: gap sqrt(d^2 - a^2/4); on a tip it is d.
+        a = 5e-4
+        self.assertAlmostEqual(self.results["valleys"]["rest_gap"], np.sqrt(0.75) * a, delta=1e-9 * a)
+        self.assertAlmostEqual(self.results["tips"]["rest_gap"], a, delta=1e-9 * a)
 
     def test_one_layer_substrate_is_rigid(self):
         r = self.results["one_layer"]
