@@ -1281,7 +1281,8 @@ namespace tribo::app
                       "k in the spring law f1 between the bodies, K = k E a^(dim-2) (N/m in 3D, N/m per m "
                       "of depth in 2D; the paper's K ~ E h estimate), > 0.");
     prm.declare_entry("Boundary range ratio", "1", Double(),
-                      "Range d of f1 as a fraction of a, in (0, 2); the block starts a distance d above the substrate.");
+                      "Range d of f1 as a fraction of a, in (0, 2); the block starts with every block-substrate "
+                      "distance >= d (Block rest).");
     prm.declare_entry("Block rest", "valleys", Selection("valleys|tips"),
                       "Where the block starts, each contact particle at the distance d of f1 from the substrate: "
                       "'valleys' (lowest, the block's lattice shifted horizontally into the substrate's hollows) "
