@@ -131,7 +131,7 @@ namespace tribo::app
         return {"mu", "normal_force", "lower_wall_normal_force", "upper_wall_y", "upper_wall_vy",
                 "gap", "power_lower_wall", "power_upper_wall", "power_dissipated",
                 "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction",
-                "elastic_energy_upper_body", "power_damping_upper_body"};
+                "elastic_energy_upper_body", "power_damping_upper_body", "upper_body_face_shift"};
       }
 
       std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
@@ -178,7 +178,8 @@ namespace tribo::app
                 ub.kinetic_energy,
                 grain_area(s) / (surface_gap * k.length),
                 ub.elastic_energy,
-                r.boundary_dissipation};
+                r.boundary_dissipation,
+                face_shift()};
       }
 
       void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
@@ -206,6 +207,16 @@ namespace tribo::app
         const double h_tb = stat("gap").first - (upper_y_to_surface + 0.5 * lower_wall_diameter);
         j.set("third_body_thickness", h_tb);
         j.set("solid_fraction_mean", stat("solid_fraction").first);
+        j.set("face_shift_mean", stat("upper_body_face_shift").first);
+        {
+          const auto shift = stats.column("upper_body_face_shift");
+          double     largest = 0;
+          for (const double x : shift)
+            largest = std::max(largest, std::abs(x));
+          j.set("face_shift_max", largest);
+          j.set("face_shift_in_half_discs",
+                half_disc_diameter > 0 ? stat("upper_body_face_shift").first / half_disc_diameter : 0.0);
+        }
         j.set("cohesion_number", prm.law.cohesion / (k.pressure * mean_grain_diameter));
         if (!sliding)
           return;
@@ -309,6 +320,23 @@ namespace tribo::app
                 body->stored_energy()};
       }
 
+      /// Mean x-displacement of the deformable upper body's contact face since the start,
+      /// sum_i (x_i - x_i(0)) / n over its chain nodes (minimum image), m; 0 for the rigid
+      /// wall, whose x is imposed. About tau H / G in steady shear.
+      double face_shift() const
+      {
+        if (!body)
+          return 0;
+        const double L = prm.shear.length;
+        double       sum = 0;
+        for (unsigned int i = 0; i < face_start.size(); ++i)
+          {
+            const double dx = body->node_position(i).x() - face_start[i];
+            sum += dx - L * std::round(dx / L);
+          }
+        return sum / face_start.size();
+      }
+
       /// The deformable upper body with its bottom face at @p bottom (m).
       void build_deformable_upper_body(double bottom)
       {
@@ -318,6 +346,8 @@ namespace tribo::app
         b.bottom             = bottom + 0.5 * half_disc_diameter;
         upper_y_to_surface   = 0.5 * half_disc_diameter;
         body                 = coupling::make_first_body(b);
+        for (unsigned int i = 0; i < body->n_nodes(); ++i)
+          face_start.push_back(body->node_position(i).x());
       }
 
       double draw_diameter()
@@ -374,6 +404,7 @@ namespace tribo::app
       double                         upper_y_to_surface = 0;
       double                         half_disc_diameter = 0;
       std::unique_ptr<coupling::FirstBody> body; ///< deformable upper body, if any
+      std::vector<double>            face_start; ///< x of its chain nodes at the start, m
       std::unique_ptr<LayerProfiles> profiles;
       SteadyState                    steady;
     };

@@ -8,15 +8,23 @@
 
 namespace tribo::dem
 {
-  HalfDiscs::HalfDiscs(const BoundaryBody &body, double diameter_, const Vec2 &outward_,
-                       double period_)
+  namespace
+  {
+    /// v rotated by +90 degrees, (-v_y, v_x).
+    Vec2 perp(const Vec2 &v) { return {-v.y(), v.x()}; }
+  } // namespace
+
+  HalfDiscs::HalfDiscs(const BoundaryBody &body, double diameter_, const Vec2 &outward, double period_)
     : diameter(diameter_)
-    , outward(outward_.normalized())
+    , side(outward.y() >= 0 ? 1.0 : -1.0)
     , period(period_)
   {
     if (!(diameter > 0) || !(period > 0) || body.n_nodes() < 2)
       throw RunError("half-disc elements need a positive diameter and period and at least two "
                      "boundary nodes");
+    if (!(std::abs(outward.y()) > 0.5 * outward.norm()))
+      throw RunError("half-disc elements: the chain runs along x, so the round sides must face "
+                     "+y or -y");
     for (unsigned int i = 0; i < body.n_nodes(); ++i)
       node_abscissa.push_back(body.node_position(i).x());
     if (!std::is_sorted(node_abscissa.begin(), node_abscissa.end()) ||
@@ -24,7 +32,12 @@ namespace tribo::dem
       throw RunError("boundary nodes must be ordered by x within [0, period)");
     const unsigned int n = std::max(1L, std::lround(period / diameter));
     for (unsigned int k = 0; k < n; ++k)
-      centre_abscissa.push_back((k + 0.5) * period / n);
+      {
+        centre_abscissa.push_back((k + 0.5) * period / n);
+        const auto [e, xi] = locate(centre_abscissa.back());
+        anchor_edge.push_back(e);
+        anchor_xi.push_back(xi);
+      }
   }
 
   std::pair<unsigned int, double> HalfDiscs::locate(double s) const
@@ -49,25 +62,25 @@ namespace tribo::dem
     return {e, std::clamp((s - s_a) / (s_b - s_a), 0.0, 1.0)};
   }
 
-  Vec2 HalfDiscs::point_at(double s, const std::vector<Vec2> &nodes) const
+  HalfDiscs::Placement HalfDiscs::placement(unsigned int k, const std::vector<Vec2> &nodes) const
   {
-    const auto [e, xi] = locate(s);
-    const unsigned int n = nodes.size();
-    Vec2               b = nodes[(e + 1) % n];
+    const unsigned int n = nodes.size(), e = anchor_edge[k];
+    const double       xi = anchor_xi[k];
+    const Vec2        &a  = nodes[e];
+    Vec2               b  = nodes[(e + 1) % n];
     if (e + 1 == n)
       b.x() += period; // the wrapping edge ends at node 0's periodic image
-    Vec2 a = nodes[e];
-    // Keep the point near abscissa s (node positions are not wrapped).
-    Vec2 p = (1 - xi) * a + xi * b;
-    p.x() -= period * std::floor((p.x() - (s - 0.5 * period)) / period);
-    return p;
+    // Keep the centre near its reference abscissa (node positions are not wrapped).
+    Vec2 c = (1 - xi) * a + xi * b;
+    c.x() -= period * std::floor((c.x() - (centre_abscissa[k] - 0.5 * period)) / period);
+    return {c, b - a};
   }
 
   std::vector<Vec2> HalfDiscs::centres(const std::vector<Vec2> &nodes) const
   {
     std::vector<Vec2> c;
-    for (const double s : centre_abscissa)
-      c.push_back(point_at(s, nodes));
+    for (unsigned int k = 0; k < count(); ++k)
+      c.push_back(placement(k, nodes).centre);
     return c;
   }
 
@@ -77,52 +90,91 @@ namespace tribo::dem
                                          const std::vector<Vec2> &nodes, double distance) const
   {
     std::vector<Contact> found;
-    const std::vector<Vec2> c = centres(nodes);
-    const unsigned int      nh = c.size();
-    const double            spacing = period / nh, rho = radius();
-    const double            reach = rho + system.max_radius() + distance;
-    const int               span  = int(std::ceil(reach / spacing)) + 1;
+    const unsigned int   nh  = count();
+    const double         rho = radius();
+    const double         reach = rho + system.max_radius() + std::max(distance, 0.0);
+    std::vector<Placement> at(nh);
+    double                 ymin = INFINITY, ymax = -INFINITY;
+    for (unsigned int k = 0; k < nh; ++k)
+      {
+        at[k] = placement(k, nodes);
+        ymin  = std::min(ymin, at[k].centre.y());
+        ymax  = std::max(ymax, at[k].centre.y());
+      }
+
+    // The displaced centres by bins along x (wrapped), each at least one reach wide:
+    // a half-disc within reach of a grain is in the grain's bin or a neighbouring one.
+    const unsigned int nbins = std::max(1L, std::min<long>(long(period / reach), nh));
+    const double       width = period / nbins;
+    const auto         bin_of = [&](double x) {
+      x -= period * std::floor(x / period);
+      return std::min<unsigned int>(nbins - 1, static_cast<unsigned int>(x / width));
+    };
+    std::vector<unsigned int> bin_start(nbins + 1, 0), items(nh);
+    for (unsigned int k = 0; k < nh; ++k)
+      ++bin_start[bin_of(at[k].centre.x()) + 1];
+    for (unsigned int b = 0; b < nbins; ++b)
+      bin_start[b + 1] += bin_start[b];
+    {
+      std::vector<unsigned int> fill(bin_start.begin(), bin_start.end() - 1);
+      for (unsigned int k = 0; k < nh; ++k)
+        items[fill[bin_of(at[k].centre.x())]++] = k;
+    }
+
     for (unsigned int d = 0; d < system.discs.size(); ++d)
       {
         const Vec2  &x = disc_centres[d];
         const double R = system.discs[d].radius;
-        const int    k0 = int(std::floor(x.x() / spacing));
-        const bool   all = 2 * span + 1 >= int(nh); // the window covers every half-disc
-        for (int j = all ? 0 : -span; j <= (all ? int(nh) - 1 : span); ++j)
+        if (x.y() < ymin - reach || x.y() > ymax + reach)
+          continue;
+        // The distinct bins b - 1, b, b + 1 (all of them when there are fewer than 3).
+        const unsigned int b0 = bin_of(x.x());
+        unsigned int       bins[3];
+        unsigned int       n_bins = 0;
+        for (int j = -1; j <= 1; ++j)
           {
-            const unsigned int k = all ? j : ((k0 + j) % int(nh) + nh) % nh;
-            Vec2 branch = x - c[k];
-            branch.x() -= period * std::round(branch.x() / period);
-            if (branch.dot(outward) <= 0)
-              continue; // behind the flat side
-            const double dist = branch.norm();
-            const double gap  = dist - R - rho;
-            if (gap > distance)
-              continue;
-            Contact ct;
-            ct.disc[0] = d; // for the warm-start key only (with half_disc)
-            ct.disc[1] = d;
-            ct.half_disc = k;
-            ct.body[0] = ct.body[1] = system.discs[d].body;
-            ct.normal = branch / dist;
-            ct.branch = branch;
-            ct.gap    = gap;
-            // Contact point and its projection on the chain.
-            const Vec2   point_from_centre = (rho + 0.5 * gap) * ct.normal;
-            const double s_p = centre_abscissa[k] + point_from_centre.x();
-            const auto [e, xi] = locate(s_p);
-            ct.node[0]        = e;
-            ct.node[1]        = (e + 1) % nodes.size();
-            ct.node_weight[0] = 1 - xi;
-            ct.node_weight[1] = xi;
-            const Vec2 t(-ct.normal.y(), ct.normal.x());
-            const Vec2 arm1 = rotate(system.discs[d].offset, body_angles[ct.body[1]]) +
-                              point_from_centre - branch;
-            ct.arm_n[0] = ct.arm_t[0] = 0;
-            ct.arm_n[1] = cross(arm1, ct.normal);
-            ct.arm_t[1] = cross(arm1, t);
-            found.push_back(ct);
+            const unsigned int b = (b0 + nbins + j) % nbins;
+            if (std::find(bins, bins + n_bins, b) == bins + n_bins)
+              bins[n_bins++] = b;
           }
+        for (unsigned int m = 0; m < n_bins; ++m)
+          for (unsigned int i = bin_start[bins[m]]; i < bin_start[bins[m] + 1]; ++i)
+            {
+              const unsigned int k = items[i];
+              const Placement   &p = at[k];
+              Vec2               branch = x - p.centre;
+              branch.x() -= period * std::round(branch.x() / period);
+              const Vec2 e_perp = perp(p.edge);
+              if (side * branch.dot(e_perp) <= 0)
+                continue; // behind the flat side
+              const double dist = branch.norm();
+              const double gap  = dist - R - rho;
+              if (gap > distance)
+                continue;
+              Contact ct;
+              ct.disc[0]   = d; // for the warm-start key only (with half_disc)
+              ct.disc[1]   = d;
+              ct.half_disc = k;
+              ct.body[0] = ct.body[1] = system.discs[d].body;
+              ct.normal = branch / dist;
+              ct.branch = branch;
+              ct.gap    = gap;
+              // The half-disc's material point at the contact point: the centre's
+              // interpolation plus the edge's rotation (dem/boundary.h).
+              const Vec2            a  = (rho + 0.5 * gap) * ct.normal;
+              const Eigen::Matrix2d turn = perp(a) * e_perp.transpose() / p.edge.squaredNorm();
+              const double          xi = anchor_xi[k];
+              ct.node[0]     = anchor_edge[k];
+              ct.node[1]     = (anchor_edge[k] + 1) % nodes.size();
+              ct.node_map[0] = (1 - xi) * Eigen::Matrix2d::Identity() - turn;
+              ct.node_map[1] = xi * Eigen::Matrix2d::Identity() + turn;
+              const Vec2 t(-ct.normal.y(), ct.normal.x());
+              const Vec2 arm1 = rotate(system.discs[d].offset, body_angles[ct.body[1]]) + a - branch;
+              ct.arm_n[0] = ct.arm_t[0] = 0;
+              ct.arm_n[1] = cross(arm1, ct.normal);
+              ct.arm_t[1] = cross(arm1, t);
+              found.push_back(ct);
+            }
       }
     return found;
   }

@@ -12,19 +12,33 @@
 /// half-discs of diameter D with their flat side on the chain and their round side
 /// towards the third body. Rule, the same for the three cases of the paper's Fig. 4
 /// (D larger than, equal to or smaller than the edge length l):
-/// - n_h = max(1, round(period / D)) half-discs, centred at the reference abscissae
-///   s_k = (k + 1/2) period / n_h; a half-disc's centre follows the chain at s_k
-///   (linear interpolation between the two nodes of the edge that holds s_k);
-/// - a grain touches half-disc k when its centre is on the round side; the contact
-///   point P is on the line of centres, in the middle of the gap;
-/// - the contact force F goes to the two nodes A, B of the edge that holds the
-///   projection of P on the chain (abscissa s_P = s_k + (P - c_k)_x: the chain runs
-///   along x), as F_A = F (1 - xi), F_B = F xi with xi = d_p / d (Cao eq. 2), and
-///   the half-disc's velocity at P is interpolated with the same weights, so the
-///   velocity map is exactly the transpose of the force map.
+/// - n_h = max(1, round(period / D)) half-discs, anchored at the reference abscissae
+///   s_k = (k + 1/2) period / n_h: half-disc k is a rigid body carried by the edge A-B
+///   that holds s_k (at the fraction xi_k of it), its centre c_k = (1 - xi_k) A + xi_k B,
+///   its flat side along AB, turning with the edge at omega = (e x de/dt) / |e|^2,
+///   e = B - A;
+/// - a grain of radius R at x touches half-disc k when x is on the round side
+///   ((x - c_k) . n_e > 0, n_e the edge's outward normal); the gap is
+///   g = |x - c_k| - R - D/2, the normal n = (x - c_k)/|x - c_k| and the contact point
+///   P = c_k + (D/2 + g/2) n, in the middle of the gap;
+/// - the half-disc's velocity at P is that of its material point,
+///   v_P = v_c + omega x a = J_A v_A + J_B v_B, a = P - c_k,
+///       J_A = (1 - xi_k) I - a_perp e_perp^T / |e|^2,  J_B = xi_k I + a_perp e_perp^T / |e|^2
+///   (v_perp = (-v_y, v_x)), and a contact force F on the half-disc goes to the nodes
+///   by the transpose, F_A = (1 - xi_k) F - e_perp M / |e|^2, F_B = xi_k F + e_perp M / |e|^2
+///   with M = a x F: the force splits as in Cao eq. (2) at the centre and its moment
+///   about the centre passes as a couple across the edge (the established code's
+///   disc-on-edge element does the same, docs/laws.md);
+/// - since a is parallel to n, n . (omega x a) = 0: the solver's normal gap rate
+///   n . (v_grain - v_c) is exactly the time derivative of the geometric gap, however
+///   the face stretches or turns and whatever D / l.
 /// With D = l each half-disc sits on one edge (the paper's choice); with D > l a
-/// half-disc spans several edges and each contact loads the edge below its point;
-/// with D < l several half-discs share an edge and their forces add on its two nodes.
+/// half-disc overhangs its edge and turns with it; with D < l several half-discs share
+/// an edge and their forces add on its two nodes.
+///
+/// Detection uses the half-discs' displaced centres, binned along x in bins at least
+/// one contact reach wide: every half-disc within reach of a grain is tested, however
+/// far the face has moved from its reference position.
 
 #include "dem/particle_system.h"
 
@@ -94,22 +108,31 @@ namespace tribo::dem
 
     /// Contacts of the discs of @p system (centres @p disc_centres, wrapped into
     /// [0, period)) with the half-discs at node positions @p nodes, for gaps up to
-    /// @p distance. Fills geometry, node indices and weights; side 0 is the
+    /// @p distance. Fills geometry, node indices and node maps; side 0 is the
     /// half-disc, side 1 the grain's body (its arms are set).
     std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &disc_centres,
                                 const std::vector<double> &disc_angles_of_bodies,
                                 const std::vector<Vec2> &nodes, double distance) const;
 
   private:
+    /// Where half-disc @p k is for node positions @p nodes: its centre (m, near its
+    /// reference abscissa) and the vector e = B - A of its edge (m).
+    struct Placement
+    {
+      Vec2 centre, edge;
+    };
+    Placement placement(unsigned int k, const std::vector<Vec2> &nodes) const;
     /// Edge holding abscissa @p s (wrapped) and the weight xi of its second node.
     std::pair<unsigned int, double> locate(double s) const;
-    /// Position on the chain at abscissa @p s for node positions @p nodes.
-    Vec2 point_at(double s, const std::vector<Vec2> &nodes) const;
 
     double              diameter;
-    Vec2                outward;
+    /// +1 if the round side faces +e_perp (e along +x in the reference: outward +y),
+    /// -1 if it faces -e_perp (the bottom face of an upper body).
+    double              side;
     double              period;
     std::vector<double> node_abscissa;   ///< reference x of the nodes, increasing
     std::vector<double> centre_abscissa; ///< s_k
+    std::vector<unsigned int> anchor_edge; ///< edge holding s_k
+    std::vector<double>       anchor_xi;   ///< xi_k, the fraction of that edge at s_k
   };
 } // namespace tribo::dem

@@ -28,12 +28,15 @@ namespace tribo::dem
     Eigen::Vector2d u_free = Eigen::Vector2d::Zero(); ///< local velocity of the free motion (no impulses), m/s
     double cohesion_impulse = 0, shift = 0, compliance = 0; ///< law terms (ContactLaw::Terms)
     /// Against a half-disc element of a BoundaryBody (dem/boundary.h): its index, else -1.
-    /// Side 0 is then the half-disc, moving with the nodes node[0], node[1] of the edge
-    /// below the contact point with weights node_weight (1 - xi, xi); body[0] and the
+    /// Side 0 is then the half-disc, a rigid body carried by the chain edge that holds
+    /// its anchor (nodes node[0] = A, node[1] = B). The velocity of its material point at
+    /// the contact point is v_P = J_A v_A + J_B v_B with J = node_map (2x2, the centre's
+    /// interpolation plus the edge's rotation, dem/boundary.h); an impulse r on the grain
+    /// puts -J_A^T f and -J_B^T f (f = r_n n + r_t t) on the nodes. body[0] and the
     /// side-0 arms are unused.
-    int          half_disc      = -1;
-    unsigned int node[2]        = {0, 0};
-    double       node_weight[2] = {0, 0};
+    int             half_disc = -1;
+    unsigned int    node[2]   = {0, 0};
+    Eigen::Matrix2d node_map[2] = {Eigen::Matrix2d::Zero(), Eigen::Matrix2d::Zero()};
 
     bool on_boundary() const { return half_disc >= 0; }
 

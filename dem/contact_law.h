@@ -25,9 +25,12 @@
 ///   (written there with the opposite sign for gamma).
 /// - Optional Coulomb friction mu: |r_t| <= mu r~_n, acting on the shifted impulse.
 
+#include "core/errors.h"
+
 #include <Eigen/Core>
 
 #include <cmath>
+#include <sstream>
 
 namespace tribo::dem
 {
@@ -78,37 +81,64 @@ namespace tribo::dem
     /// Closed-form local solve. @p W is the contact's own 2x2 Delassus block
     /// (m/s per N s/m), @p u_other the local velocity produced by
     /// the free motion and every other impulse (u = W r + u_other). Returns r.
+    /// With friction the 2x2 problem is solved exactly by enumeration
+    /// (solve_coulomb()); throws RunError if no case satisfies the law.
     Eigen::Vector2d solve(const Eigen::Matrix2d &W, const Eigen::Vector2d &u_other,
                           const Terms &t) const
     {
       const double gh = t.cohesion_impulse;
-      // Shifted problem: u = W r~ + q, with q = u_other - W (gh, 0) + (b, 0).
+      // Shifted problem: u = W~ r~ + q, with q = u_other - W (gh, 0) + (b, 0) and W~ the
+      // block with the law's compliance added to W_nn.
       const double qn  = u_other.x() - W(0, 0) * gh + t.shift;
       const double qt  = u_other.y() - W(1, 0) * gh;
       const double Wnn = W(0, 0) + t.compliance;
       Eigen::Vector2d r(0, 0);
       if (friction <= 0)
-        {
-          r.x() = qn < 0 ? -qn / Wnn : 0;
-        }
-      else if (qn < 0) // closing: stick if inside the cone, else slide
-        {
-          const double det = Wnn * W(1, 1) - W(0, 1) * W(1, 0);
-          const double rn  = (-qn * W(1, 1) + qt * W(0, 1)) / det;
-          const double rt  = (-qt * Wnn + qn * W(1, 0)) / det;
-          if (rn > 0 && std::abs(rt) <= friction * rn)
-            r = {rn, rt};
-          else
-            {
-              // Sliding: r_t = s mu r~_n, s the sign of the stick trial's r_t.
-              const double s     = (rt >= 0 ? 1.0 : -1.0);
-              const double denom = Wnn + s * friction * W(0, 1);
-              if (denom > 0)
-                r = {-qn / denom, -s * friction * qn / denom};
-            }
-        }
+        r.x() = qn < 0 ? -qn / Wnn : 0;
+      else if (qn < 0) // closing: the no-contact case (r~ = 0, u_n = q_n) fails the law
+        r = solve_coulomb(Wnn, W(0, 1), W(1, 0), W(1, 1), qn, qt);
       r.x() -= gh;
       return r;
+    }
+
+    /// The frictional local problem u = W~ r~ + q with q_n < 0 (no contact would
+    /// interpenetrate), 0 <= r~_n _|_ u_n >= 0, |r~_t| <= mu r~_n, u_t = 0 if
+    /// |r~_t| < mu r~_n, else r~_t = -mu r~_n sign(u_t). Enumerates the cases in the
+    /// order stick (u = 0), slide with s = sign of the stick trial's r~_t, slide with -s
+    /// (u_n = 0, r~_t = s mu r~_n, r~_n = -q_n / (W~_nn + s mu W~_nt), valid if r~_n >= 0
+    /// and s u_t <= 0), and returns the first that satisfies the law. A coupled block
+    /// (W_nt != 0: clumps, half-discs) can make the stick trial's sign wrong, and its
+    /// sliding denominator vanish or turn negative; the enumeration handles both.
+    /// Throws RunError, with the block and q, if no case satisfies the law.
+    Eigen::Vector2d solve_coulomb(double Wnn, double Wnt, double Wtn, double Wtt, double qn,
+                                  double qt) const
+    {
+      constexpr double tol = 1e-10; // relative, for round-off at the case boundaries
+      const double     det = Wnn * Wtt - Wnt * Wtn;
+      double           s   = 1;
+      if (det > 0)
+        {
+          const double rn = (-qn * Wtt + qt * Wnt) / det;
+          const double rt = (-qt * Wnn + qn * Wtn) / det;
+          if (rn >= 0 && std::abs(rt) <= friction * rn * (1 + tol))
+            return {rn, rt};
+          s = rt >= 0 ? 1.0 : -1.0;
+        }
+      for (const double sign : {s, -s})
+        {
+          const double denom = Wnn + sign * friction * Wnt;
+          if (!(denom > 0))
+            continue; // r~_n = -q_n / denom would be negative or unbounded
+          const double rn = -qn / denom, rt = sign * friction * rn;
+          const double ut = Wtn * rn + Wtt * rt + qt;
+          if (sign * ut <= tol * (std::abs(Wtn * rn) + std::abs(Wtt * rt) + std::abs(qt)))
+            return {rn, rt};
+        }
+      std::ostringstream os;
+      os << "the frictional local problem has no solution (mu = " << friction << ", W~ = [" << Wnn
+         << ", " << Wnt << "; " << Wtn << ", " << Wtt << "], q = (" << qn << ", " << qt
+         << ")): the contact's Delassus block is not positive definite";
+      throw RunError(os.str());
     }
   };
 } // namespace tribo::dem

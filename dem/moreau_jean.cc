@@ -171,7 +171,7 @@ namespace tribo::dem
         const Vec2 f = (c.r.x() * c.normal + c.r.y() * t) / h;
         if (c.on_boundary())
           for (int k = 0; k < 2; ++k)
-            node_impulse[c.node[k]] -= c.node_weight[k] * h * f;
+            node_impulse[c.node[k]] -= h * (c.node_map[k].transpose() * f);
         for (int s = c.on_boundary() ? 1 : 0; s < 2; ++s)
           {
             const double sign = s == 0 ? -1.0 : 1.0;

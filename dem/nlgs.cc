@@ -28,10 +28,10 @@ namespace tribo::dem
     v.x() += im[0] * f.x();
     v.y() += im[1] * f.y();
     v.z() += im[2] * (c.arm_n[1] * dr.x() + c.arm_t[1] * dr.y());
-    // The nodes receive -(1 - xi) f and -xi f: two column pairs of the compliance.
+    // The nodes receive -J_A^T f and -J_B^T f: two column pairs of the compliance.
     const Eigen::MatrixXd &G = *node_compliance;
     for (int k = 0; k < 2; ++k)
-      node_velocity.noalias() -= G.middleCols<2>(2 * c.node[k]) * (c.node_weight[k] * f);
+      node_velocity.noalias() -= G.middleCols<2>(2 * c.node[k]) * (c.node_map[k].transpose() * f);
   }
 
   Eigen::Matrix2d BodyState::delassus_block(const Contact &c) const
@@ -44,8 +44,8 @@ namespace tribo::dem
         Eigen::Matrix<double, 4, 2> B;
         for (int k = 0; k < 2; ++k)
           {
-            B.block<2, 1>(2 * k, 0) = -c.node_weight[k] * c.normal;
-            B.block<2, 1>(2 * k, 1) = -c.node_weight[k] * t;
+            B.block<2, 1>(2 * k, 0) = -c.node_map[k].transpose() * c.normal;
+            B.block<2, 1>(2 * k, 1) = -c.node_map[k].transpose() * t;
           }
         Eigen::Matrix4d G;
         for (int a = 0; a < 2; ++a)

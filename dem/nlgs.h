@@ -159,15 +159,15 @@ namespace tribo::dem
 
     /// The own Delassus block of @p c, sum over its two bodies of H^T M^-1 H (for a
     /// half-disc contact: the grain's part plus B^T G_AB B, with B the 4x2 map from
-    /// (r_n, r_t) to the impulses -(1 - xi) f, -xi f on its two nodes).
+    /// (r_n, r_t) to the impulses -J_A^T f, -J_B^T f on its two nodes, dem/boundary.h).
     Eigen::Matrix2d delassus_block(const Contact &c) const;
 
-    /// Side 0 of a half-disc contact: velocity of its point, interpolated from the
-    /// nodes with the weights (1 - xi, xi), m/s.
+    /// Side 0 of a half-disc contact: velocity of the half-disc's material point at the
+    /// contact point, J_A v_A + J_B v_B (Contact::node_map), m/s.
     Vec2 half_disc_velocity(const Contact &c) const
     {
-      return c.node_weight[0] * node_velocity.segment<2>(2 * c.node[0]) +
-             c.node_weight[1] * node_velocity.segment<2>(2 * c.node[1]);
+      return c.node_map[0] * node_velocity.segment<2>(2 * c.node[0]) +
+             c.node_map[1] * node_velocity.segment<2>(2 * c.node[1]);
     }
 
   private:

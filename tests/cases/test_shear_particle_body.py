@@ -7,8 +7,10 @@ the coupling limit of 1):
 
 - equilibrium: the mean normal force on the lower wall while shearing is P L within
   5 %. The force rings with the body (10-batch means over the window spread by 10 %,
-  standard error of the mean 0.018 P L), hence 3 us of shear: over 0.6 us the mean
-  was anywhere within 15 % of P L;
+  standard error of the mean 0.018 P L with the half-disc kinematics before 2026-11-25,
+  0.028-0.037 P L over seeds 1-3 since the half-discs move with their edge's centre,
+  docs/laws.md), hence 3 us of shear: over 0.6 us the mean was anywhere within 15 % of
+  P L; the window must resolve the 5 % check to better than 0.04 P L;
 - energy: every step while shearing, the grains' kinetic energy plus the body's kinetic
   and potential energy change by h (power_external + power_contacts -
   power_damping_upper_body) within 5 % of the step's mean |work|, and over the window
@@ -75,7 +77,7 @@ class MlpUpperBody(unittest.TestCase):
         shearing = st["time"] > SHEAR_START + 1e-7
         force = st["lower_wall_normal_force"][shearing] / (P * L)
         batches = np.array([b.mean() for b in np.array_split(force, 10)])
-        self.assertLess(batches.std(ddof=1) / np.sqrt(10), 0.03)  # the window is long enough
+        self.assertLess(batches.std(ddof=1) / np.sqrt(10), 0.04)  # the window is long enough
         self.assertAlmostEqual(force.mean(), 1.0, delta=0.05)
 
     def test_energy_balance_every_step(self):

@@ -338,10 +338,12 @@ class Collision(RunOnce, unittest.TestCase):
 
 #: summary.json "results" keys of a shear run, in this order (docs/outputs.md).
 COMPACTION_RESULTS = ["sliding", "averaging_start", "normal_force_mean", "normal_force_target",
-                      "third_body_thickness", "solid_fraction_mean", "cohesion_number"]
+                      "third_body_thickness", "solid_fraction_mean", "face_shift_mean",
+                      "face_shift_max", "face_shift_in_half_discs", "cohesion_number"]
 SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "averaging_start",
                    "normal_force_mean", "normal_force_target", "third_body_thickness",
-                   "solid_fraction_mean", "cohesion_number", "mu_mean", "mu_std",
+                   "solid_fraction_mean", "face_shift_mean", "face_shift_max",
+                   "face_shift_in_half_discs", "cohesion_number", "mu_mean", "mu_std",
                    "power_lower_wall_mean", "power_upper_wall_mean", "power_dissipated_mean",
                    "power_third_body_mean", "power_balance_ratio", "energy_rate_mean",
                    "power_balance_closure", "inertial_number",

@@ -105,33 +105,34 @@ TEST(HalfDiscs, ContactBelowAnEdgeMidpointSplitsTheForceEvenly)
   EXPECT_NEAR(c.normal.y(), -1.0, 1e-12); // from the half-disc to the grain
   EXPECT_EQ(c.node[0], 2u);               // edge 2: nodes 2 and 3
   EXPECT_EQ(c.node[1], 3u);
-  EXPECT_NEAR(c.node_weight[0], 0.5, 1e-12);
-  EXPECT_NEAR(c.node_weight[1], 0.5, 1e-12);
+  // A normal force through the centre has no moment: half of it on each node.
+  for (int k = 0; k < 2; ++k)
+    EXPECT_NEAR((c.node_map[k].transpose() * c.normal - 0.5 * c.normal).norm(), 0.0, 1e-12);
 }
 
-TEST(HalfDiscs, OffCentreContactUsesTheEdgeBelowItsPoint)
+TEST(HalfDiscs, OffCentreContactLoadsTheAnchorEdgeWithForceAndMoment)
 {
-  // A grain below and to the right of half-disc 2 along 45 degrees: contact point at
-  // x = 2.5 l + (D/2 + gap/2) cos 45, with D = 2 l (spanning edges) it lies on a later edge.
+  // A grain below and to the right of half-disc 1 along 45 degrees, D = 2 l: the
+  // half-disc (centre at x = 3 l, anchored on edge 3 at xi = 0) overhangs edges 2 and 3,
+  // and its contact point lies above edge 3 at 3.71 l. The force goes to the anchor
+  // edge's nodes; they receive the whole force and its moment about the centre.
   const double r = 0.5e-6, D = 2 * l, gap = 1e-8;
   const double a = (0.5 * D + r + gap) / std::sqrt(2.0);
-  // With D = 2 l the half-discs sit at (k + 1/2) 2 l: half-disc 1 at x = 3 l.
-  const auto cs = contacts_of_grain({3 * l + a, y_face - a}, r, D, 2e-8);
-  const double xp = 3 * l + (0.5 * D + 0.5 * gap) / std::sqrt(2.0);
-  // Node i is at i l: the edge holding xp and its weight.
-  const unsigned int e  = unsigned(std::floor(xp / l));
-  const double       xi = xp / l - e;
-  ASSERT_EQ(e, 3u); // 3.71 l: half-disc 1 spans edges 2 and 3, the point is on edge 3
-  unsigned found = 0;
+  const auto   cs = contacts_of_grain({3 * l + a, y_face - a}, r, D, 2e-8);
+  unsigned     found = 0;
   for (const auto &c : cs)
     if (c.half_disc == 1)
       {
         ++found;
         EXPECT_NEAR(c.gap, gap, 1e-15);
-        EXPECT_EQ(c.node[0], e);
-        EXPECT_EQ(c.node[1], e + 1);
-        EXPECT_NEAR(c.node_weight[1], xi, 1e-9);
-        EXPECT_NEAR(c.node_weight[0], 1 - xi, 1e-9);
+        EXPECT_EQ(c.node[0], 3u);
+        EXPECT_EQ(c.node[1], 4u);
+        const Vec2 centre(3 * l, y_face), A(3 * l, y_face), B(4 * l, y_face);
+        const Vec2 arm = (0.5 * D + 0.5 * gap) * c.normal; // centre -> contact point
+        const Vec2 F(0.3, -1.1);                           // a force on the half-disc
+        const Vec2 FA = c.node_map[0].transpose() * F, FB = c.node_map[1].transpose() * F;
+        EXPECT_NEAR((FA + FB - F).norm(), 0.0, 1e-12);
+        EXPECT_NEAR(cross(A - centre, FA) + cross(B - centre, FB), cross(arm, F), 1e-18);
       }
   EXPECT_EQ(found, 1u);
 }
@@ -139,8 +140,8 @@ TEST(HalfDiscs, OffCentreContactUsesTheEdgeBelowItsPoint)
 TEST(HalfDiscs, DetectedAcrossThePeriodicBoundary)
 {
   // A grain at x = 0.05 l touches half-disc 0 (x = 0.5 l) and, across the boundary,
-  // half-disc 7 (x = 7.5 l, image at -0.5 l), whose contact point lies at about
-  // -0.26 l, i.e. 7.74 l on the wrapping edge 7 (node 7 -> node 0).
+  // half-disc 7 (x = 7.5 l, image at -0.5 l), carried by the wrapping edge 7
+  // (node 7 -> node 0).
   const double r = 0.5e-6;
   const auto   cs = contacts_of_grain({0.05 * l, y_face - 0.5 * l - r}, r, l, 0.3e-6);
   std::vector<int> seen;
@@ -152,11 +153,72 @@ TEST(HalfDiscs, DetectedAcrossThePeriodicBoundary)
     if (c.half_disc == 7)
       {
         EXPECT_GT(c.normal.x(), 0.0); // the grain is to the right of half-disc 7's image
-        const double xp = -0.5 * l + (0.5 * l + 0.5 * c.gap) * c.normal.x() + L;
+        EXPECT_NEAR(c.branch.x(), 0.55 * l, 1e-15);
         EXPECT_EQ(c.node[0], 7u);
         EXPECT_EQ(c.node[1], 0u);
-        EXPECT_NEAR(c.node_weight[1], xp / l - 7, 1e-9);
       }
+}
+
+TEST(HalfDiscs, GapRateIsTheGeometricRateOnATurnedAndStretchedFace)
+{
+  // Nodes displaced and moving with a rotation, a stretch and a random part; grains
+  // around the half-discs, moving too. The solver's normal velocity u_n (BodyState) must
+  // be the time derivative of the gap that detection measures (central difference),
+  // for D < l, D = l and D > l (the paper's Fig. 4 c, b, a).
+  std::mt19937                           gen(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const unsigned int                     n = 8;
+  const double                           dt = 1e-12;
+  unsigned int                           checked = 0;
+  for (const double D : {0.5 * l, l, 2 * l})
+    for (int trial = 0; trial < 40; ++trial)
+      {
+        LumpedChain       chain(n, L, y_face, 1e-8);
+        HalfDiscs         hd(chain, D, {0, -1}, L);
+        std::vector<Vec2> x(n), v(n);
+        const double      spin = 2e6 * U(gen), stretch = 3e6 * U(gen); // 1/s
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            const Vec2 rel = chain.x[i] - Vec2(0.5 * L, y_face);
+            x[i] = chain.x[i] + 0.05 * l * Vec2(U(gen), U(gen));
+            v[i] = spin * Vec2(-rel.y(), rel.x()) + stretch * Vec2(rel.x(), 0) + 0.5 * Vec2(U(gen), U(gen));
+          }
+        // A grain near a random half-disc, below it at a random angle.
+        const auto   centres = hd.centres(x);
+        const double r = 0.5e-6, phi = 0.45 * M_PI * U(gen);
+        const Vec2   c = centres[trial % hd.count()];
+        const Vec2   xg = c + (0.5 * D + r + 0.02 * l) * Vec2(std::sin(phi), -std::cos(phi));
+        const Vec2   vg(U(gen), U(gen));
+        const auto   at = [&](double t, int k) -> std::vector<Contact> {
+          ParticleSystem s;
+          s.period = L;
+          s.add_disc(xg + t * vg, r, rho);
+          std::vector<Vec2> xt(n);
+          for (unsigned int i = 0; i < n; ++i)
+            xt[i] = x[i] + t * v[i];
+          std::vector<Contact> out;
+          for (const Contact &ct : hd.detect(s, {s.wrap(xg + t * vg)}, {0.0}, xt, 0.1 * l))
+            if (ct.half_disc == k)
+              out.push_back(ct);
+          return out;
+        };
+        const int  k   = trial % hd.count();
+        const auto now = at(0, k), before = at(-dt, k), after = at(dt, k);
+        ASSERT_EQ(now.size(), 1u);
+        ASSERT_EQ(before.size(), 1u);
+        ASSERT_EQ(after.size(), 1u);
+        BodyState state;
+        state.velocity      = {Eigen::Vector3d(vg.x(), vg.y(), 0)};
+        state.inverse_mass  = {{{1, 1, 1}}};
+        state.node_velocity = Eigen::VectorXd(2 * n);
+        for (unsigned int i = 0; i < n; ++i)
+          state.node_velocity.segment<2>(2 * i) = v[i];
+        const double rate = (after[0].gap - before[0].gap) / (2 * dt);
+        EXPECT_NEAR(state.local_velocity(now[0]).x(), rate, 1e-6 * (std::abs(rate) + 1))
+          << "D = " << D / l << " l, trial " << trial;
+        ++checked;
+      }
+  EXPECT_EQ(checked, 120u);
 }
 
 TEST(HalfDiscs, VelocityMapIsTheTransposeOfTheForceMap)
@@ -233,7 +295,7 @@ TEST(HalfDiscs, ImpactOnALumpedChainConservesMomentum)
   EXPECT_NEAR(p1.x(), p0.x(), 1e-12 * p0.norm());
   EXPECT_NEAR(p1.y(), p0.y(), 1e-12 * p0.norm());
   const Contact &c = mj.contacts()[0];
-  const Vec2 v_point = (1 - c.node_weight[1]) * chain.v[c.node[0]] + c.node_weight[1] * chain.v[c.node[1]];
+  const Vec2 v_point = c.node_map[0] * chain.v[c.node[0]] + c.node_map[1] * chain.v[c.node[1]];
   EXPECT_NEAR(c.normal.dot(s.bodies[g].velocity - v_point) + c.shift, 0.0, 1e-9); // closed at the end
   EXPECT_GT(chain.momentum().y(), 0.0); // pushed up
 }

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 using namespace tribo;
 using dem::Vec2;
@@ -102,4 +104,170 @@ TEST(Coupling, StiffBlockMovesLikeARigidBody)
   for (unsigned int i = 0; i < 8; ++i)
     for (unsigned int j = 0; j < 8; ++j)
       EXPECT_NEAR(G(2 * i + 1, 2 * j + 1), 1 / M, 0.02 / M) << i << " " << j;
+}
+
+namespace
+{
+  /// The deal.II body's bottom face translated along x by @p shift (m) after the
+  /// half-discs were placed: the imposed displacement of a face sheared by tau H / G,
+  /// without waiting for a soft body to deform that far.
+  class ShiftedBoundary : public coupling::ElasticBoundary
+  {
+  public:
+    using coupling::ElasticBoundary::ElasticBoundary;
+    Vec2 node_position(unsigned int i) const override
+    {
+      return coupling::ElasticBoundary::node_position(i) + Vec2(shift, 0);
+    }
+    double shift = 0;
+  };
+
+  constexpr unsigned int wide = 16; ///< cells along the period of the shifted-face tests
+
+  /// Pairs (grain, half-disc) of @p s's free discs with a gap at most @p distance to the
+  /// half-discs of diameter l centred at @p centres (a flat face: the round sides face -y).
+  std::vector<std::pair<unsigned int, int>> geometric_contacts(const dem::ParticleSystem &s,
+                                                               const std::vector<Vec2> &centres,
+                                                               double distance, double *deepest = nullptr)
+  {
+    std::vector<std::pair<unsigned int, int>> pairs;
+    for (unsigned int d = 0; d < s.discs.size(); ++d)
+      {
+        if (!s.bodies[s.discs[d].body].is_free())
+          continue;
+        for (unsigned int k = 0; k < centres.size(); ++k)
+          {
+            Vec2 b = s.disc_centre(d) - centres[k];
+            b.x() -= s.period * std::round(b.x() / s.period);
+            if (b.y() >= 0)
+              continue; // behind the flat side
+            const double gap = b.norm() - s.discs[d].radius - 0.5 * l;
+            if (deepest)
+              *deepest = std::min(*deepest, gap);
+            if (gap <= distance)
+              pairs.emplace_back(d, int(k));
+          }
+      }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+  }
+} // namespace
+
+TEST(Coupling, HalfDiscsOfAShiftedFaceAreAllDetected)
+{
+  // Grains scattered under the face of a deal.II body shifted by 1, 3 and 6 spacings (and
+  // half spacings more): detection finds exactly the pairs a brute-force search finds.
+  fem::ElasticBodyParameters prm;
+  prm.length    = wide * l;
+  prm.thickness = 4 * l;
+  prm.bottom    = 5 * l;
+  prm.cells_x   = wide;
+  prm.cells_y   = 4;
+  fem::ElasticBody body(prm);
+  ShiftedBoundary  boundary(body);
+  dem::HalfDiscs   hd(boundary, l, {0, -1}, prm.length);
+  std::mt19937                           gen(7);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (const double spacings : {1.0, 3.0, 6.0, 1.5, 3.5, 6.5, 3.3})
+    {
+      boundary.shift = spacings * l;
+      std::vector<Vec2> nodes;
+      for (unsigned int i = 0; i < boundary.n_nodes(); ++i)
+        nodes.push_back(boundary.node_position(i));
+      dem::ParticleSystem s;
+      s.period = prm.length;
+      std::vector<Vec2> centres;
+      for (int g = 0; g < 300; ++g)
+        {
+          const Vec2 x(prm.length * U(gen), prm.bottom - 1.2 * l * U(gen) - 0.1 * l);
+          s.add_disc(x, (0.4 + 0.2 * U(gen)) * l, rho);
+          centres.push_back(s.wrap(x));
+        }
+      std::vector<double> angles(s.bodies.size(), 0.0);
+      const double        distance = 0.05 * l;
+      std::vector<std::pair<unsigned int, int>> found;
+      for (const auto &c : hd.detect(s, centres, angles, nodes, distance))
+        found.emplace_back(c.disc[1], c.half_disc);
+      std::sort(found.begin(), found.end());
+      const auto expected = geometric_contacts(s, hd.centres(nodes), distance);
+      EXPECT_GT(expected.size(), 100u);
+      EXPECT_EQ(found, expected) << "face shifted by " << spacings << " spacings";
+    }
+}
+
+TEST(Coupling, GrainsSlidingUnderAShiftedFaceAreNeverLost)
+{
+  // A column of grains in the pockets of a sliding rigid wall, under a deal.II block
+  // pressed at P whose face is shifted by 1, 3 and 6 spacings: over 400 steps of sliding
+  // at 2 m/s (0.8 spacing), every grain-half-disc pair closer than half the detection
+  // distance at the end of a step was a contact of that step, no grain overlaps a
+  // half-disc by more than 5 % of its radius, none gets behind the face, and the
+  // wall carries P L.
+  for (const double spacings : {1.0, 3.0, 6.0})
+    {
+      dem::ParticleSystem s;
+      s.period = wide * l;
+      std::vector<Vec2>   c;
+      std::vector<double> r;
+      for (unsigned int i = 0; i < wide; ++i)
+        {
+          c.push_back({i * l, 0});
+          r.push_back(0.5 * l);
+        }
+      const unsigned int wall = s.add_clump(c, r, rho);
+      for (auto &d : s.bodies[wall].drive)
+        d = dem::Drive::velocity;
+      for (unsigned int i = 0; i < wide; ++i)
+        s.add_disc({(i + 0.5) * l, y_grain}, 0.5 * l, rho);
+      fem::ElasticBodyParameters prm;
+      prm.length             = wide * l;
+      prm.thickness          = 8 * l;
+      prm.bottom             = y_grain + l;
+      prm.cells_x            = wide;
+      prm.cells_y            = 8;
+      prm.top_pressure       = P;
+      prm.pressure_ramp_time = 2e-8;
+      prm.time_step          = 1e-9;
+      prm.rayleigh_mass      = 2e8;
+      fem::ElasticBody    body(prm);
+      ShiftedBoundary     boundary(body);
+      dem::NlgsParameters nlgs;
+      nlgs.tolerance      = 1e-6;
+      nlgs.check_interval = 1;
+      const double    distance = 0.05 * l;
+      dem::MoreauJean mj(0.5, dem::ContactLaw{}, nlgs, distance);
+      mj.attach(boundary, l, {0, -1}, prm.length);
+      dem::HalfDiscs hd(boundary, l, {0, -1}, prm.length);
+      boundary.shift = spacings * l;
+      double wall_force = 0;
+      for (int step = 0; step < 400; ++step)
+        {
+          if (step == 100)
+            s.bodies[wall].velocity.x() = 2.0;
+          mj.step(s, 1e-9);
+          std::vector<std::pair<unsigned int, int>> detected;
+          for (const auto &ct : mj.contacts())
+            if (ct.on_boundary())
+              detected.emplace_back(ct.disc[1], ct.half_disc);
+          std::sort(detected.begin(), detected.end());
+          std::vector<Vec2> nodes;
+          for (unsigned int i = 0; i < boundary.n_nodes(); ++i)
+            nodes.push_back(boundary.node_position(i));
+          const auto centres = hd.centres(nodes);
+          double     deepest = 0;
+          for (const auto &p : geometric_contacts(s, centres, 0.5 * distance, &deepest))
+            ASSERT_TRUE(std::binary_search(detected.begin(), detected.end(), p))
+              << "grain " << p.first << " against half-disc " << p.second << " not detected at step "
+              << step << ", face shifted by " << spacings << " spacings";
+          ASSERT_GT(deepest, -0.05 * 0.5 * l) << "step " << step << ", shift " << spacings;
+          double face_y = 0;
+          for (const Vec2 &x : centres)
+            face_y += x.y() / centres.size();
+          for (unsigned int g = 1; g <= wide; ++g)
+            ASSERT_LT(s.bodies[g].position.y(), face_y) << "grain " << g << " behind the face, step " << step;
+          if (step >= 300)
+            wall_force += -mj.contact_force()[wall].y() / 100;
+        }
+      EXPECT_NEAR(wall_force, P * prm.length, 0.05 * P * prm.length) << "shift " << spacings;
+    }
 }
