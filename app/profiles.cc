@@ -52,6 +52,8 @@ namespace tribo::app
     for (const auto &n : quantity_names())
       c.push_back(n);
     c.push_back("n_samples");
+    for (const auto &n : quantity_names())
+      c.push_back(n + "_stderr");
     return c;
   }
 
@@ -165,12 +167,34 @@ namespace tribo::app
       return out;
     double mean_gap = 0;
     std::vector<double> sum(layers * n_quantities, 0.0);
+    // Batch means: the samples of the window in time order, cut into B = min(10, n)
+    // contiguous batches of (nearly) equal size; stderr = std(batch means, B - 1) / sqrt(B).
+    const unsigned int               n_batches = std::min(10u, n);
+    std::vector<std::vector<double>> batch(n_batches, std::vector<double>(layers * n_quantities, 0.0));
+    std::vector<unsigned int>        batch_size(n_batches, 0);
+    unsigned int                     index = 0;
     for (std::size_t i = 0; i < times.size(); ++i)
       if (times[i] >= t_start)
         {
           mean_gap += gap[i] / n;
+          const unsigned int b = index++ * n_batches / n;
+          ++batch_size[b];
           for (std::size_t j = 0; j < sum.size(); ++j)
-            sum[j] += data[i][j] / n;
+            {
+              sum[j] += data[i][j] / n;
+              batch[b][j] += data[i][j];
+            }
+        }
+    std::vector<double> stderr_of(sum.size(), NAN);
+    if (n_batches >= 2)
+      for (std::size_t j = 0; j < sum.size(); ++j)
+        {
+          double mean = 0, square = 0;
+          for (unsigned int b = 0; b < n_batches; ++b)
+            mean += batch[b][j] / batch_size[b] / n_batches;
+          for (unsigned int b = 0; b < n_batches; ++b)
+            square += std::pow(batch[b][j] / batch_size[b] - mean, 2);
+          stderr_of[j] = std::sqrt(square / (n_batches - 1) / n_batches);
         }
     for (unsigned int k = 0; k < layers; ++k)
       {
@@ -179,6 +203,8 @@ namespace tribo::app
         for (int q = 0; q < n_quantities; ++q)
           r.push_back(sum[k * n_quantities + q]);
         r.push_back(n);
+        for (int q = 0; q < n_quantities; ++q)
+          r.push_back(stderr_of[k * n_quantities + q]);
         out.push_back(r);
       }
     return out;

@@ -50,7 +50,12 @@ namespace tribo::app
 
     /// Mean over the samples with time >= @p t_start: one row per layer,
     /// columns: layer, y (layer centre above the lower wall surface, m), y_over_h
-    /// (y over the gap between the wall surfaces), then quantity_names(), n_samples.
+    /// (y over the gap between the wall surfaces), then quantity_names(), n_samples,
+    /// then the standard error of each quantity's mean, `<name>_stderr`, by batch means:
+    /// the n samples in time order cut into B = min(10, n) contiguous batches,
+    /// stderr = sqrt(sum_b (m_b - m)^2 / ((B - 1) B)) with m_b the batch means and m
+    /// their mean (NaN for n < 2). Correlation between samples shorter than a batch
+    /// does not bias it low, as the sample standard deviation over sqrt(n) would.
     std::vector<std::vector<double>> average(double t_start) const;
     static std::vector<std::string> average_columns();
 

@@ -69,14 +69,13 @@ def main(directory):
         if p.size > 1:
             fig, axes = plt.subplots(1, 4, figsize=(11, 3.8), sharey=True)
             y = p["y_over_h"]
-            axes[0].plot(p["vx"], y, "o-", ms=3)
-            axes[0].set_xlabel("vx (m/s)")
-            axes[1].plot(p["solid_fraction"], y, "o-", ms=3)
-            axes[1].set_xlabel("solid fraction")
-            axes[2].plot(p["sigma_yy"] / 1e6, y, "o-", ms=3)
-            axes[2].set_xlabel("sigma_yy (MPa)")
-            axes[3].plot(p["sigma_xy"] / 1e6, y, "o-", ms=3)
-            axes[3].set_xlabel("sigma_xy (MPa)")
+            columns = [("vx", 1, "vx (m/s)"), ("solid_fraction", 1, "solid fraction"),
+                       ("sigma_yy", 1e6, "sigma_yy (MPa)"), ("sigma_xy", 1e6, "sigma_xy (MPa)")]
+            for a, (name, scale, label) in zip(axes, columns):
+                # Error bars: the batch-means standard error of each layer's mean (profiles.csv).
+                err = p[name + "_stderr"] / scale if name + "_stderr" in p.dtype.names else None
+                a.errorbar(p[name] / scale, y, xerr=err, fmt="o-", ms=3, capsize=2)
+                a.set_xlabel(label)
             axes[0].set_ylabel("y / h (lower wall 0, upper wall 1)")
             for a in axes:
                 a.grid(alpha=0.3)

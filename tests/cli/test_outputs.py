@@ -685,6 +685,11 @@ class Sliding(ShearRun, unittest.TestCase):
         self.assertEqual(r["profile_samples_in_steady_state"], int(steady.sum()))
         self.assertGreater(steady.sum(), 0)
         np.testing.assert_array_equal(p["n_samples"], steady.sum())
+        # Standard errors by batch means: finite and non-negative, and the grains' velocities
+        # do fluctuate from batch to batch in every layer.
+        for q in ("vx", "solid_fraction", "sigma_xx", "sigma_yy", "sigma_xy", "sigma_yx", "n_discs"):
+            self.assertTrue(np.all(np.isfinite(p[q + "_stderr"]) & (p[q + "_stderr"] >= 0)), q)
+        self.assertTrue(np.all(p["vx_stderr"] > 0))
         # Layers: fixed at the first sample, about one mean diameter each.
         mwd = self.mean_wall_diameter()
         gap_at = {t: g for t, g in zip(self.stats["time"], self.stats["gap"])}

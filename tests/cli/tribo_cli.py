@@ -50,7 +50,8 @@ SCENE_COLUMNS = {
 }
 #: Columns of profiles.csv (and datasets of the HDF5 group "profiles"), in this order.
 PROFILE_COLUMNS = ["layer", "y", "y_over_h", "vx", "solid_fraction", "sigma_xx", "sigma_yy",
-                   "sigma_xy", "sigma_yx", "n_discs", "n_samples"]
+                   "sigma_xy", "sigma_yx", "n_discs", "n_samples"] + \
+    [q + "_stderr" for q in ("vx", "solid_fraction", "sigma_xx", "sigma_yy", "sigma_xy", "sigma_yx", "n_discs")]
 #: PNG plots of a shear run with Output/Plots = true (scripts/plot_run.py).
 PLOTS = ["mu.png", "power.png", "profiles.png"]
 
