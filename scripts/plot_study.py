@@ -4,7 +4,8 @@
     /usr/bin/python3 scripts/plot_study.py STUDY_OUTPUT_DIR
 
 Reads study_summary.csv and each complete case's profiles.csv; writes
-profiles_overlay.png (vx, sigma_yy, sigma_xy across the gap, one curve per case)
+profiles_overlay.png (vx, sigma_yy, sigma_xy across the gap, one curve per case, with
+error bars of the batch-means standard error where profiles.csv has `*_stderr`)
 and, when mu_mean is known, mu_by_case.png (mean friction with its standard
 deviation against the first varied parameter, one curve per value of the second).
 """
@@ -46,7 +47,9 @@ def main(directory):
         if p.size < 2:
             continue
         for ax, q, scale in zip(axes, ("vx", "sigma_yy", "sigma_xy"), (1, 1e-6, 1e-6)):
-            ax.plot(p[q] * scale, p["y_over_h"], "o-", ms=2, label=label(r))
+            # Error bars: the batch-means standard error of each layer's mean, when present.
+            err = p[q + "_stderr"] * scale if q + "_stderr" in p.dtype.names else None
+            ax.errorbar(p[q] * scale, p["y_over_h"], xerr=err, fmt="o-", ms=2, capsize=1.5, label=label(r))
         plotted += 1
     if plotted:
         axes[0].set_xlabel("vx (m/s)")
