@@ -1,4 +1,5 @@
 #include "app/profiles.h"
+#include "app/steady_state.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -167,34 +168,16 @@ namespace tribo::app
       return out;
     double mean_gap = 0;
     std::vector<double> sum(layers * n_quantities, 0.0);
-    // Batch means: the samples of the window in time order, cut into B = min(10, n)
-    // contiguous batches of (nearly) equal size; stderr = std(batch means, B - 1) / sqrt(B).
-    const unsigned int               n_batches = std::min(10u, n);
-    std::vector<std::vector<double>> batch(n_batches, std::vector<double>(layers * n_quantities, 0.0));
-    std::vector<unsigned int>        batch_size(n_batches, 0);
-    unsigned int                     index = 0;
+    std::vector<std::vector<double>> series(layers * n_quantities); ///< per column, time order
     for (std::size_t i = 0; i < times.size(); ++i)
       if (times[i] >= t_start)
         {
           mean_gap += gap[i] / n;
-          const unsigned int b = index++ * n_batches / n;
-          ++batch_size[b];
           for (std::size_t j = 0; j < sum.size(); ++j)
             {
               sum[j] += data[i][j] / n;
-              batch[b][j] += data[i][j];
+              series[j].push_back(data[i][j]);
             }
-        }
-    std::vector<double> stderr_of(sum.size(), NAN);
-    if (n_batches >= 2)
-      for (std::size_t j = 0; j < sum.size(); ++j)
-        {
-          double mean = 0, square = 0;
-          for (unsigned int b = 0; b < n_batches; ++b)
-            mean += batch[b][j] / batch_size[b] / n_batches;
-          for (unsigned int b = 0; b < n_batches; ++b)
-            square += std::pow(batch[b][j] / batch_size[b] - mean, 2);
-          stderr_of[j] = std::sqrt(square / (n_batches - 1) / n_batches);
         }
     for (unsigned int k = 0; k < layers; ++k)
       {
@@ -204,10 +187,31 @@ namespace tribo::app
           r.push_back(sum[k * n_quantities + q]);
         r.push_back(n);
         for (int q = 0; q < n_quantities; ++q)
-          r.push_back(stderr_of[k * n_quantities + q]);
+          r.push_back(batch_standard_error(batch_means(series[k * n_quantities + q])));
         out.push_back(r);
       }
     return out;
+  }
+
+  std::pair<double, double> LayerProfiles::interior_mean(const std::string &quantity, double t_start) const
+  {
+    const auto names = quantity_names();
+    const int  q     = std::find(names.begin(), names.end(), quantity) - names.begin();
+    if (q == int(names.size()) || layers < 5 || n_samples_after(t_start) == 0)
+      return {NAN, NAN};
+    std::vector<double> series; // per sample: the mean over layers 2 .. n - 3
+    for (std::size_t i = 0; i < times.size(); ++i)
+      if (times[i] >= t_start)
+        {
+          double sum = 0;
+          for (unsigned int k = 2; k + 2 < layers; ++k)
+            sum += data[i][k * n_quantities + q];
+          series.push_back(sum / (layers - 4));
+        }
+    double mean = 0;
+    for (const double x : series)
+      mean += x / series.size();
+    return {mean, batch_standard_error(batch_means(series))};
   }
   void LayerProfiles::save(CheckpointOut &ar) const
   {

@@ -27,6 +27,7 @@
 #include "dem/particle_system.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tribo::app
@@ -51,13 +52,16 @@ namespace tribo::app
     /// Mean over the samples with time >= @p t_start: one row per layer,
     /// columns: layer, y (layer centre above the lower wall surface, m), y_over_h
     /// (y over the gap between the wall surfaces), then quantity_names(), n_samples,
-    /// then the standard error of each quantity's mean, `<name>_stderr`, by batch means:
-    /// the n samples in time order cut into B = min(10, n) contiguous batches,
-    /// stderr = sqrt(sum_b (m_b - m)^2 / ((B - 1) B)) with m_b the batch means and m
-    /// their mean (NaN for n < 2). Correlation between samples shorter than a batch
-    /// does not bias it low, as the sample standard deviation over sqrt(n) would.
+    /// then the standard error of each quantity's mean, `<name>_stderr`, by batch means
+    /// over the samples in time order (batch_standard_error(), steady_state.h).
     std::vector<std::vector<double>> average(double t_start) const;
     static std::vector<std::string> average_columns();
+
+    /// Mean over the samples with time >= @p t_start of @p quantity averaged over the
+    /// layers 2 .. n - 3 (at least two layers from each wall), and its batch-means
+    /// standard error (steady_state.h) over the per-sample layer averages; NaN with fewer
+    /// than 5 layers or no sample.
+    std::pair<double, double> interior_mean(const std::string &quantity, double t_start) const;
 
     unsigned int n_layers() const { return layers; }
     unsigned int n_samples() const { return times.size(); }

@@ -201,13 +201,28 @@ namespace tribo::app
         else
           steady.start = t1 + 1; // no profile sample is in a steady state
         const auto stat = [&](const std::string &name) { return mean_and_std(time, stats.column(name), start); };
+        // Standard errors by batch means over the averaging window (steady_state.h).
+        const auto stderr_of = [&](const std::string &name) {
+          return mean_and_stderr(time, stats.column(name), start).second;
+        };
+        const auto window_batches = [&](const std::string &name) {
+          const auto          v = stats.column(name);
+          std::vector<double> window;
+          for (std::size_t i = 0; i < time.size(); ++i)
+            if (time[i] >= start)
+              window.push_back(v[i]);
+          return batch_means(window);
+        };
         j.set("averaging_start", start);
         j.set("normal_force_mean", stat("lower_wall_normal_force").first);
+        j.set("normal_force_stderr", stderr_of("lower_wall_normal_force"));
         j.set("normal_force_target", k.pressure * k.length);
         const double h_tb = stat("gap").first - (upper_y_to_surface + 0.5 * lower_wall_diameter);
         j.set("third_body_thickness", h_tb);
         j.set("solid_fraction_mean", stat("solid_fraction").first);
+        j.set("solid_fraction_stderr", stderr_of("solid_fraction"));
         j.set("face_shift_mean", stat("upper_body_face_shift").first);
+        j.set("face_shift_stderr", stderr_of("upper_body_face_shift"));
         {
           const auto shift = stats.column("upper_body_face_shift");
           double     largest = 0;
@@ -224,6 +239,7 @@ namespace tribo::app
         const auto [mu_mean, mu_std] = stat("mu");
         j.set("mu_mean", mu_mean);
         j.set("mu_std", mu_std);
+        j.set("mu_stderr", stderr_of("mu"));
         const double p_lb = stat("power_lower_wall").first, p_ub = stat("power_upper_wall").first;
         const double p_diss = stat("power_dissipated").first;
         j.set("power_lower_wall_mean", p_lb);
@@ -231,6 +247,14 @@ namespace tribo::app
         j.set("power_dissipated_mean", p_diss);
         j.set("power_third_body_mean", stat("power_free").first);
         j.set("power_balance_ratio", p_lb != 0 ? p_diss / p_lb : NAN);
+        {
+          // Per batch: the ratio of the batch means of P_diss and P_LB.
+          auto ratio = window_batches("power_dissipated");
+          const auto lower_wall = window_batches("power_lower_wall");
+          for (std::size_t b = 0; b < ratio.size(); ++b)
+            ratio[b] /= lower_wall[b];
+          j.set("power_balance_ratio_stderr", batch_standard_error(ratio));
+        }
         // The whole balance: what the walls put in goes into dissipation (contacts and a
         // deformable body's damping) or into the energy the grains and the body hold.
         {
@@ -254,16 +278,11 @@ namespace tribo::app
         j.set("profile_samples_in_steady_state", long(profiles->n_samples_after(steady.start)));
 
         // Mean stresses over the layers at least two layers away from the walls.
-        const auto rows = profiles->average(steady.start);
-        const auto cols = LayerProfiles::average_columns();
         for (const std::string q : {"sigma_xx", "sigma_yy", "sigma_xy"})
           {
-            const auto c   = std::find(cols.begin(), cols.end(), q) - cols.begin();
-            double     sum = 0;
-            int        n   = 0;
-            for (std::size_t i = 2; i + 2 < rows.size(); ++i, ++n)
-              sum += rows[i][c];
-            j.set(q + "_mean", n ? sum / n : NAN);
+            const auto [mean, error] = profiles->interior_mean(q, steady.start);
+            j.set(q + "_mean", mean);
+            j.set(q + "_stderr", error);
           }
       }
 

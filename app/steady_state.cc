@@ -61,4 +61,47 @@ namespace tribo::app
     const double m = sum / n;
     return {m, std::sqrt(std::max(0.0, sum2 / n - m * m))};
   }
+
+  std::vector<double> batch_means(const std::vector<double> &series)
+  {
+    const std::size_t   n = series.size();
+    const std::size_t   B = std::min<std::size_t>(standard_error_batches, n);
+    std::vector<double> m(B, 0.0);
+    for (std::size_t b = 0; b < B; ++b)
+      {
+        const std::size_t first = b * n / B, last = (b + 1) * n / B;
+        for (std::size_t i = first; i < last; ++i)
+          m[b] += series[i] / (last - first);
+      }
+    return m;
+  }
+
+  double batch_standard_error(const std::vector<double> &m)
+  {
+    const std::size_t B = m.size();
+    if (B < 2)
+      return NAN;
+    double mean = 0, square = 0;
+    for (const double x : m)
+      mean += x / B;
+    for (const double x : m)
+      square += (x - mean) * (x - mean);
+    return std::sqrt(square / ((B - 1) * B));
+  }
+
+  std::pair<double, double> mean_and_stderr(const std::vector<double> &time, const std::vector<double> &v,
+                                            double start)
+  {
+    std::vector<double> window;
+    for (std::size_t i = 0; i < time.size(); ++i)
+      if (time[i] >= start)
+        window.push_back(v[i]);
+    if (window.empty())
+      return {NAN, NAN};
+    const auto m = batch_means(window);
+    double     mean = 0;
+    for (const double x : window)
+      mean += x / window.size();
+    return {mean, batch_standard_error(m)};
+  }
 } // namespace tribo::app

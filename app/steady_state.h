@@ -26,4 +26,22 @@ namespace tribo::app
   /// Mean and standard deviation of @p v over the rows with time >= @p start.
   std::pair<double, double> mean_and_std(const std::vector<double> &time, const std::vector<double> &v,
                                          double start);
+
+  /// Number of batches of the batch-means estimator.
+  constexpr unsigned int standard_error_batches = 10;
+
+  /// The B = min(10, n) batch means of @p series (time order): contiguous batches of
+  /// (nearly) equal size, batch b holding rows [b n / B, (b + 1) n / B).
+  std::vector<double> batch_means(const std::vector<double> &series);
+
+  /// Standard error of the mean of a series from its batch means @p m_b (B of them):
+  /// sqrt(sum_b (m_b - m)^2 / ((B - 1) B)), m their mean; NaN for B < 2. Batches longer
+  /// than the series' correlation time make this account for the correlation, which the
+  /// plain std / sqrt(n) does not (for an AR(1) series with coefficient phi that one is
+  /// too small by sqrt((1 + phi) / (1 - phi))).
+  double batch_standard_error(const std::vector<double> &batch_means);
+
+  /// Mean of @p v over the rows with time >= @p start and its batch-means standard error.
+  std::pair<double, double> mean_and_stderr(const std::vector<double> &time, const std::vector<double> &v,
+                                            double start);
 } // namespace tribo::app

@@ -337,18 +337,20 @@ class Collision(RunOnce, unittest.TestCase):
 # The shear scene.
 
 #: summary.json "results" keys of a shear run, in this order (docs/outputs.md).
-COMPACTION_RESULTS = ["sliding", "averaging_start", "normal_force_mean", "normal_force_target",
-                      "third_body_thickness", "solid_fraction_mean", "face_shift_mean",
+COMPACTION_RESULTS = ["sliding", "averaging_start", "normal_force_mean", "normal_force_stderr",
+                      "normal_force_target", "third_body_thickness", "solid_fraction_mean",
+                      "solid_fraction_stderr", "face_shift_mean", "face_shift_stderr",
                       "face_shift_max", "face_shift_in_half_discs", "cohesion_number"]
 SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "averaging_start",
-                   "normal_force_mean", "normal_force_target", "third_body_thickness",
-                   "solid_fraction_mean", "face_shift_mean", "face_shift_max",
-                   "face_shift_in_half_discs", "cohesion_number", "mu_mean", "mu_std",
+                   "normal_force_mean", "normal_force_stderr", "normal_force_target",
+                   "third_body_thickness", "solid_fraction_mean", "solid_fraction_stderr",
+                   "face_shift_mean", "face_shift_stderr", "face_shift_max",
+                   "face_shift_in_half_discs", "cohesion_number", "mu_mean", "mu_std", "mu_stderr",
                    "power_lower_wall_mean", "power_upper_wall_mean", "power_dissipated_mean",
-                   "power_third_body_mean", "power_balance_ratio", "energy_rate_mean",
-                   "power_balance_closure", "inertial_number",
-                   "profile_samples_in_steady_state", "sigma_xx_mean", "sigma_yy_mean",
-                   "sigma_xy_mean"]
+                   "power_third_body_mean", "power_balance_ratio", "power_balance_ratio_stderr",
+                   "energy_rate_mean", "power_balance_closure", "inertial_number",
+                   "profile_samples_in_steady_state", "sigma_xx_mean", "sigma_xx_stderr",
+                   "sigma_yy_mean", "sigma_yy_stderr", "sigma_xy_mean", "sigma_xy_stderr"]
 
 
 def shear_sections(n, end_time, shear_start, ramp_time, plots, **extra):
@@ -658,6 +660,21 @@ class Sliding(ShearRun, unittest.TestCase):
                             ("power_third_body_mean", "power_free")):
             np.testing.assert_allclose(r[key], st[column][w].mean(), rtol=1e-12, err_msg=key)
         np.testing.assert_allclose(r["mu_std"], st["mu"][w].std(), rtol=1e-9)
+        # Standard errors by batch means: B = 10 contiguous batches of the window's rows.
+        def batches(v):
+            n = len(v)
+            return np.array([v[b * n // 10:(b + 1) * n // 10].mean() for b in range(10)])
+
+        def stderr(m):
+            return m.std(ddof=1) / math.sqrt(len(m))
+
+        for key, column in (("mu_stderr", "mu"), ("normal_force_stderr", "lower_wall_normal_force"),
+                            ("solid_fraction_stderr", "solid_fraction")):
+            np.testing.assert_allclose(r[key], stderr(batches(st[column][w])), rtol=1e-9, err_msg=key)
+        np.testing.assert_allclose(r["power_balance_ratio_stderr"],
+                                   stderr(batches(st["power_dissipated"][w]) / batches(st["power_lower_wall"][w])),
+                                   rtol=1e-9)
+        self.assertGreater(r["mu_stderr"], 0)
         np.testing.assert_allclose(r["power_balance_ratio"], r["power_dissipated_mean"] / r["power_lower_wall_mean"],
                                    rtol=1e-12)
         # The whole balance (rigid upper wall: the energy is the grains' kinetic energy).
