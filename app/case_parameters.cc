@@ -60,6 +60,20 @@ namespace tribo::app
     prm.leave_subsection();
 
     prm.enter_subsection("Solver");
+    prm.declare_entry("Method", "nlgs", Selection("nlgs|active-set"),
+                      "Contact solver: 'nlgs' (nonlinear Gauss-Seidel, the entries below) or "
+                      "'active-set' (primal-dual active-set Newton method on the frictionless "
+                      "problem, the sparse Delassus operator factorised by CHOLMOD, exact up to "
+                      "round-off; with friction the steps use NLGS and the log says so). "
+                      "docs/performance.md compares them.");
+    prm.declare_entry("Regularization", "1e-10", Double(),
+                      "Active set: relative regularisation delta in [0, 1e-4]: W_SS + delta diag(W_SS) "
+                      "is factorised (redundant contacts make W_SS singular).");
+    prm.declare_entry("Predictor sweeps", "10", Integer(0),
+                      "Active set: NLGS sweeps that predict the active set before the Newton "
+                      "iterations, >= 0.");
+    prm.declare_entry("Maximum factorizations", "50", Integer(1),
+                      "Active set: Newton iterations per step before finishing with NLGS, >= 1.");
     prm.declare_entry("Tolerance", "1e-4", Double(), "NLGS tolerance, > 0 (relative, see Norm).");
     prm.declare_entry("Norm", "Quad", Selection("Quad|Maxm"),
                       "Convergence norm of the established NSCD code: 'Quad' (mean-square) or "
@@ -219,20 +233,26 @@ namespace tribo::app
     p.detection_distance =
       f.get_checked("Contact law/Detection distance", non_negative, "a distance >= 0 in m");
 
+    p.solver.method = f.get("Solver/Method") == "active-set" ? dem::SolverParameters::Method::active_set
+                                                           : dem::SolverParameters::Method::nlgs;
+    p.solver.regularization = f.get_checked("Solver/Regularization", [](double v) { return v >= 0 && v <= 1e-4; },
+                                            "a regularisation in [0, 1e-4]");
+    p.solver.max_factorizations = f.get_integer("Solver/Maximum factorizations");
+    p.solver.predictor_sweeps   = f.get_integer("Solver/Predictor sweeps");
     p.solver.tolerance = f.get_checked("Solver/Tolerance", positive, "a positive tolerance");
-    p.solver.norm = f.get("Solver/Norm") == "Quad" ? dem::NlgsParameters::Norm::quad : dem::NlgsParameters::Norm::maxm;
+    p.solver.norm = f.get("Solver/Norm") == "Quad" ? dem::SolverParameters::Norm::quad : dem::SolverParameters::Norm::maxm;
     p.solver.relaxation = f.get_checked("Solver/Relaxation", [](double v) { return v > 0 && v <= 1; },
                                         "a relaxation in (0, 1]");
     p.solver.check_interval = f.get_integer("Solver/Check interval");
     p.solver.max_iterations = f.get_integer("Solver/Maximum iterations");
     const std::string order = f.get("Solver/Contact order");
-    p.solver.order = order == "random"        ? dem::NlgsParameters::Order::random
-                     : order == "alternating" ? dem::NlgsParameters::Order::alternating
-                                              : dem::NlgsParameters::Order::fixed;
+    p.solver.order = order == "random"        ? dem::SolverParameters::Order::random
+                     : order == "alternating" ? dem::SolverParameters::Order::alternating
+                                              : dem::SolverParameters::Order::fixed;
     p.solver.seed           = f.get_integer("Solver/Seed");
     p.solver.threads        = f.get_integer("Solver/Threads");
     p.solver.streams        = f.get_integer("Solver/Streams");
-    if (p.solver.threads > 1 && p.solver.order != dem::NlgsParameters::Order::fixed)
+    if (p.solver.threads > 1 && p.solver.order != dem::SolverParameters::Order::fixed)
       f.fail("Solver/Threads", "1 with Solver/Contact order = " + order +
                                  " (bands solved at once need the fixed order)");
     p.gap_tolerance         = f.get_checked("Solver/Gap tolerance", non_negative, "a fraction >= 0 of the smallest radius");

@@ -72,7 +72,7 @@ namespace tribo::app
     double      theta;
     dem::ContactLaw     law;
     double              detection_distance; ///< m; 0: a tenth of the smallest radius
-    dem::NlgsParameters solver;
+    dem::SolverParameters solver;
     double              gap_tolerance; ///< Solver/Gap tolerance, fraction of the smallest radius
     unsigned int statistics_interval; ///< steps between rows of statistics.csv
     unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)

@@ -32,7 +32,7 @@ namespace tribo::app
   {
     const std::vector<std::string> common_columns = {
       "time", "step", "n_contacts", "n_active_contacts", "nlgs_iterations", "nlgs_residual",
-      "nlgs_converged", "epsilon", "max_overlap", "kinetic_energy", "power_external",
+      "nlgs_converged", "law_residual", "gap_violation", "epsilon", "max_overlap", "kinetic_energy", "power_external",
       "power_free", "power_contacts"};
 
     void write_fields(FieldWriter &writer, double t, const dem::ParticleSystem &s,
@@ -356,7 +356,7 @@ namespace tribo::app
     scene->build(system);
     const double h        = scene->time_step(system);
     const double distance = p.detection_distance > 0 ? p.detection_distance : 0.1 * system.min_radius();
-    dem::NlgsParameters solver = p.solver;
+    dem::SolverParameters solver = p.solver;
     solver.gap_tolerance       = p.gap_tolerance * system.min_radius();
     dem::MoreauJean mj(p.theta, p.law, solver, distance);
     scene->attach(mj);
@@ -368,6 +368,9 @@ namespace tribo::app
       log(os.str());
       if (!scene->description().empty())
         log(scene->description());
+      if (p.solver.method == dem::SolverParameters::Method::active_set && p.law.friction > 0)
+        log("Solver/Method = active-set solves frictionless problems only: with Coulomb friction (mu = " +
+            std::to_string(p.law.friction) + ") every step uses NLGS");
     }
     // What building the case cost: the modules a case does not use are not built (a rigid
     // wall builds no deal.II, SPH or MLP object).
@@ -388,13 +391,17 @@ namespace tribo::app
     std::string   status = "complete", failure;
     unsigned long step = 0, total_iterations = 0, non_converged = 0, max_iterations = 0;
     double        worst_overlap = 0, t = 0, max_residual = 0;
+    // The law residual (dem/law_residual.h) over the steps, and the active set's work.
+    double        max_law_residual = 0, sum_law_residual = 0, max_gap_violation = 0;
+    unsigned long total_factorizations = 0, fallbacks = 0;
     StepTiming    timing;          ///< the steps since the start or the last resumption
 
     // After the header (RunCheckpoint), the loop's counters and every object's state, in
     // this order (core/checkpoint.h).
     const auto save_checkpoint = [&]() {
       checkpoint.write([&](CheckpointOut &ar) {
-        ar << step << total_iterations << non_converged << max_iterations << worst_overlap << max_residual;
+        ar << step << total_iterations << non_converged << max_iterations << worst_overlap << max_residual
+           << max_law_residual << sum_law_residual << max_gap_violation << total_factorizations << fallbacks;
         system.save(ar);
         mj.save(ar);
         scene->save(ar);
@@ -405,7 +412,8 @@ namespace tribo::app
     if (resuming)
       {
         checkpoint.read(log, [&](CheckpointIn &ar) {
-          ar >> step >> total_iterations >> non_converged >> max_iterations >> worst_overlap >> max_residual;
+          ar >> step >> total_iterations >> non_converged >> max_iterations >> worst_overlap >> max_residual >>
+            max_law_residual >> sum_law_residual >> max_gap_violation >> total_factorizations >> fallbacks;
           system.load(ar);
           mj.load(ar);
           scene->load(ar);
@@ -441,6 +449,11 @@ namespace tribo::app
             timing.add(r);
             max_iterations = std::max<unsigned long>(max_iterations, r.solver.iterations);
             max_residual   = std::max(max_residual, r.solver.residual);
+            max_law_residual  = std::max(max_law_residual, r.solver.law_residual);
+            sum_law_residual += r.solver.law_residual;
+            max_gap_violation = std::max(max_gap_violation, r.solver.gap_violation);
+            total_factorizations += r.solver.factorizations;
+            fallbacks += r.solver.fell_back ? 1 : 0;
             worst_overlap  = std::max(worst_overlap, r.max_overlap);
             if (!r.solver.converged && ++non_converged <= 10)
               {
@@ -456,7 +469,8 @@ namespace tribo::app
             const bool last     = step == n_steps || scene->finished() || stopping;
             last_row = {t, double(step), double(r.n_contacts), double(r.n_active),
                         double(r.solver.iterations), r.solver.residual,
-                        r.solver.converged ? 1.0 : 0.0, r.epsilon, r.max_overlap,
+                        r.solver.converged ? 1.0 : 0.0, r.solver.law_residual,
+                        r.solver.gap_violation, r.epsilon, r.max_overlap,
                         r.kinetic_energy, r.power_external, r.power_free, r.power_contacts};
             last_row.insert(last_row.end(), extra.begin(), extra.end());
             if (step % p.statistics_interval == 0 || last)
@@ -509,6 +523,13 @@ namespace tribo::app
     summary.set("nlgs_iterations_max", long(max_iterations));
     summary.set("nlgs_residual_max", max_residual);
     summary.set("nlgs_non_converged_steps", long(non_converged));
+    summary.set("law_residual_max", max_law_residual);
+    summary.set("law_residual_mean", step ? sum_law_residual / step : 0.0);
+    summary.set("gap_violation_max", max_gap_violation);
+    summary.set("solver_method", p.solver.method == dem::SolverParameters::Method::active_set
+                                   ? std::string("active-set") : std::string("nlgs"));
+    summary.set("factorizations_mean", step ? double(total_factorizations) / step : 0.0);
+    summary.set("active_set_fallbacks", long(fallbacks));
     summary.set("max_overlap", worst_overlap);
     summary.set("max_overlap_over_min_radius", worst_overlap / system.min_radius());
     summary.set("n_bodies", long(system.bodies.size()));
@@ -548,11 +569,16 @@ namespace tribo::app
     std::ostringstream os;
     os << "status " << status << ": " << step << " steps in " << wall << " s, "
        << (step ? double(total_iterations) / step : 0.0) << " NLGS sweeps per step, "
-       << non_converged << " steps not converged, worst overlap " << worst_overlap << " m";
+       << non_converged << " steps not converged, law residual mean "
+       << (step ? sum_law_residual / step : 0.0) << " max " << max_law_residual
+       << ", worst overlap " << worst_overlap << " m";
+    if (p.solver.method == dem::SolverParameters::Method::active_set)
+      os << ", " << (step ? double(total_factorizations) / step : 0.0)
+         << " factorisations per step, " << fallbacks << " NLGS fallbacks";
     if (timing.steps > 0)
       {
         const double n = timing.steps;
-        os << "; per step " << 1e3 * timing.step / n << " ms: NLGS " << 1e3 * timing.solver / n
+        os << "; per step " << 1e3 * timing.step / n << " ms: solver " << 1e3 * timing.solver / n
            << " ms, detection " << 1e3 * timing.detection / n << " ms, upper body "
            << 1e3 * timing.boundary_body / n << " ms";
       }

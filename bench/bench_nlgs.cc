@@ -95,7 +95,7 @@ int main(int argc, char **argv)
   const double step_time = seconds_since(t0) / timed_steps;
   std::printf("steps at tol %g (%s, check every %u): %.4f s per step, %.1f sweeps, %.0f contacts "
               "(%.0f active) per step\n",
-              p.solver.tolerance, p.solver.norm == dem::NlgsParameters::Norm::quad ? "Quad" : "Maxm",
+              p.solver.tolerance, p.solver.norm == dem::SolverParameters::Norm::quad ? "Quad" : "Maxm",
               p.solver.check_interval, step_time, double(sweeps) / timed_steps,
               double(contacts) / timed_steps, double(active) / timed_steps);
   std::printf("per step: detection %.3f ms, NLGS %.3f ms, rest (free state, local problems, "
@@ -110,7 +110,7 @@ int main(int argc, char **argv)
   // (1) fixed sweeps on the last step's contacts, from their converged impulses.
   std::vector<dem::Contact> frozen = mj.contacts();
   dem::BodyState            state  = dem::BodyState::of(system);
-  dem::NlgsParameters fixed = p.solver;
+  dem::SolverParameters fixed = p.solver;
   fixed.tolerance           = 1e-300; // never converges: exactly max_iterations sweeps
   fixed.max_iterations      = 200;
   fixed.check_interval      = 1000000;

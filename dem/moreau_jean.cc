@@ -1,6 +1,7 @@
 #include "dem/moreau_jean.h"
 
 #include "core/errors.h"
+#include "dem/law_residual.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -13,11 +14,19 @@
 
 namespace tribo::dem
 {
-  MoreauJean::MoreauJean(double theta, const ContactLaw &law, const NlgsParameters &solver,
+  MoreauJean::MoreauJean(double theta, const ContactLaw &law, const SolverParameters &solver,
                          double detection_distance)
     : th(theta)
     , contact_law(law)
     , solver(solver)
+    , active_set(solver)
+    , predictor([&] {
+      SolverParameters p = solver;
+      p.max_iterations   = std::max(1U, solver.predictor_sweeps);
+      p.check_interval   = p.max_iterations;
+      p.tolerance        = 1e-300; // never stops early
+      return p;
+    }())
     // The detection distance always covers the cohesion range.
     , distance(std::max(detection_distance, law.cohesion_range))
   {}
@@ -137,8 +146,32 @@ namespace tribo::dem
         state.apply_impulse(c, c.r);
 
     phase              = std::chrono::steady_clock::now();
-    report.solver      = solver.solve(current, state, contact_law, th * h);
+    const SolverParameters &controls = solver.parameters();
+    if (controls.method == SolverParameters::Method::active_set && contact_law.friction <= 0)
+      {
+        unsigned int sweeps = 0;
+        if (controls.predictor_sweeps > 0)
+          sweeps = predictor.solve(current, state, contact_law, th * h).iterations;
+        report.solver            = active_set.solve(current, state, contact_law);
+        const unsigned int factorizations = report.solver.factorizations;
+        if (!report.solver.converged)
+          {
+            // Not found within its budget: NLGS from the predictor's impulses.
+            report.solver           = solver.solve(current, state, contact_law, th * h);
+            report.solver.fell_back = true;
+          }
+        report.solver.factorizations = factorizations;
+        report.solver.iterations += sweeps;
+      }
+    else
+      report.solver = solver.solve(current, state, contact_law, th * h);
     report.time_solver = seconds_since(phase);
+    const LawResidual accuracy   = law_residual(current, state, contact_law, th * h);
+    report.solver.law_residual  = accuracy.relative;
+    report.solver.gap_violation = accuracy.gap_violation;
+    if (controls.method == SolverParameters::Method::active_set && !report.solver.fell_back &&
+        contact_law.friction <= 0)
+      report.solver.residual = accuracy.relative;
 
     // Gap measures with the final velocities.
     next_impulse.clear();

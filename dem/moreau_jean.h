@@ -3,11 +3,13 @@
 /// (Cao et al. 2011, eqs. 4-5; Jean 1999). Over a step [t_i, t_i + h]:
 /// - free velocity: v_free = v_i + h M^-1 F_ext (constant imposed loads);
 /// - detection at the predicted configuration q_pred = q_i + (1 - theta) h v_i;
-/// - local problems u = W r + u_free with W = H^T M^-1 H, solved by NLGS;
+/// - local problems u = W r + u_free with W = H^T M^-1 H, solved by NLGS or the
+///   active-set method (SolverParameters::method);
 /// - velocity v_{i+1} = v_free + M^-1 H r, position q_{i+1} = q_pred + theta h v_{i+1}.
 /// Imposed-velocity dofs keep their velocity. Impulses are warm-started from
 /// the previous step's contact between the same two discs.
 
+#include "dem/active_set.h"
 #include "dem/boundary.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
@@ -28,7 +30,7 @@ namespace tribo::dem
   {
     unsigned int n_contacts = 0; ///< detected pairs within the detection distance
     unsigned int n_active   = 0; ///< contacts with a non-zero impulse
-    NlgsReport   solver;
+    SolveReport   solver;
     /// Cao et al. eq. (13): mean over active contacts of g_c - g_p, the end-of-step
     /// gap with contact impulses minus the one without, theta h (u_n - u_free,n), m.
     double epsilon = 0;
@@ -89,7 +91,7 @@ namespace tribo::dem
   class MoreauJean
   {
   public:
-    MoreauJean(double theta, const ContactLaw &law, const NlgsParameters &solver,
+    MoreauJean(double theta, const ContactLaw &law, const SolverParameters &solver,
                double detection_distance);
 
     /// Couple @p body (not owned; it must outlive this) to the discs through half-disc
@@ -120,6 +122,8 @@ namespace tribo::dem
     double                   th;
     ContactLaw               contact_law;
     NlgsSolver               solver;
+    ActiveSetSolver          active_set;
+    NlgsSolver               predictor; ///< the active set's predictor sweeps
     double                   distance;
     ContactDetector          detector;
     std::vector<Contact>     current;

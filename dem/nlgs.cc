@@ -68,7 +68,7 @@ namespace tribo::dem
     return W;
   }
 
-  NlgsSolver::NlgsSolver(const NlgsParameters &p)
+  NlgsSolver::NlgsSolver(const SolverParameters &p)
     : prm(p)
     , rng(p.seed)
   {}
@@ -119,13 +119,13 @@ namespace tribo::dem
       }
 
       /// max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm ones), relative to @p tol.
-      double criterion(NlgsParameters::Norm norm, double tol) const
+      double criterion(SolverParameters::Norm norm, double tol) const
       {
         const double N         = active;
         const double quad_wr   = std::sqrt(wrwr / N);
         const double mean_wrr  = wrr / N;
         const double mean_dvor = wrr > 0 ? dvor / (wrr * tol) : 0;
-        const bool   quad      = norm == NlgsParameters::Norm::quad;
+        const bool   quad      = norm == SolverParameters::Norm::quad;
         const double dv_norm   = quad_wr > 0 ? std::sqrt(quad ? dvdv / N : max_dvdv) / (quad_wr * tol) : 0;
         const double dvr_norm =
           mean_wrr > 0 ? std::sqrt(quad ? dvdvrr / N : max_dvdvrr) / (mean_wrr * tol) : 0;
@@ -162,10 +162,10 @@ namespace tribo::dem
     }
   } // namespace
 
-  NlgsReport NlgsSolver::solve(std::vector<Contact> &contacts, BodyState &state,
+  SolveReport NlgsSolver::solve(std::vector<Contact> &contacts, BodyState &state,
                                const ContactLaw &law, double theta_h)
   {
-    NlgsReport report;
+    SolveReport report;
     const std::size_t n = contacts.size();
     if (n == 0)
       return report;
@@ -179,13 +179,13 @@ namespace tribo::dem
 
     // Bands: [begin[k], begin[k + 1]) in the order; one band for the serial sweep (and for
     // the orders that move contacts between bands: random, alternating).
-    const bool         banded  = prm.threads > 1 && n >= 2 * prm.threads && prm.order == NlgsParameters::Order::fixed;
+    const bool         banded  = prm.threads > 1 && n >= 2 * prm.threads && prm.order == SolverParameters::Order::fixed;
     const unsigned int n_bands = banded ? 2 * prm.threads : 1;
     std::vector<unsigned int> begin(n_bands + 1);
     for (unsigned int k = 0; k <= n_bands; ++k)
       begin[k] = static_cast<unsigned int>(n * k / n_bands);
     report.concurrent = n_bands > 1 && bands_independent(contacts, begin, state.velocity.size());
-    if (prm.order == NlgsParameters::Order::fixed && prm.streams > 1)
+    if (prm.order == SolverParameters::Order::fixed && prm.streams > 1)
       for (unsigned int k = 0; k < n_bands; ++k)
         {
           // Band k in windows of streams x spacing contacts; a window's contacts in
@@ -259,9 +259,9 @@ namespace tribo::dem
 
     for (unsigned int sweep = 1; sweep <= prm.max_iterations; ++sweep)
       {
-        if (prm.order == NlgsParameters::Order::random)
+        if (prm.order == SolverParameters::Order::random)
           std::shuffle(order.begin(), order.end(), rng);
-        else if (prm.order == NlgsParameters::Order::alternating && sweep > 1)
+        else if (prm.order == SolverParameters::Order::alternating && sweep > 1)
           std::reverse(order.begin(), order.end());
         if (n_bands == 1)
           solve_band(0);

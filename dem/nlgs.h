@@ -32,9 +32,35 @@
 
 namespace tribo::dem
 {
-  /// Controls of the NLGS solver.
-  struct NlgsParameters
+  /// Controls of the contact solve: the method, and the NLGS's own controls.
+  struct SolverParameters
   {
+    /// The method: nonlinear Gauss-Seidel (below), or the primal-dual active-set
+    /// (semismooth Newton) method on the frictionless problem with the sparse Delassus
+    /// operator factorised by CHOLMOD (dem/active_set.h; with friction the step uses
+    /// NLGS and says so).
+    enum class Method
+    {
+      nlgs,
+      active_set
+    };
+    Method method = Method::nlgs;
+    /// Active set: relative proximal regularisation delta, W_SS + delta diag(W_SS) is
+    /// factorised (redundant, hyperstatic contacts make W_SS singular) and proximal steps
+    /// remove its effect (dem/active_set.h).
+    double regularization = 1e-6;
+    /// Active set: NLGS sweeps before the Newton iterations, predicting the active set
+    /// (0: the warm start's prediction alone).
+    unsigned int predictor_sweeps = 10;
+    /// Active set: proximal steps (solves) per step before finishing with NLGS.
+    unsigned int max_proximal_steps = 200;
+    /// Active set: factorisations per step before falling back to NLGS from its best
+    /// iterate.
+    unsigned int max_factorizations = 50;
+    /// Active set: a contact is infeasible when its impulse is below -tau x_mean or its
+    /// law velocity below -tau x_mean W_nn, x_mean the mean loaded impulse of the warm
+    /// start (round-off in an ill-conditioned W_SS must not flip contacts back and forth).
+    double feasibility_tolerance = 1e-10;
     enum class Norm
     {
       quad,
@@ -87,13 +113,20 @@ namespace tribo::dem
   };
 
   /// What one solve achieved.
-  struct NlgsReport
+  struct SolveReport
   {
-    unsigned int iterations   = 0; ///< sweeps done (check passes not included)
+    unsigned int iterations   = 0; ///< NLGS sweeps done (check passes not included)
+    /// Active set: sparse factorisations done (Newton iterations), and whether it fell
+    /// back to NLGS (which then reports its sweeps in iterations).
+    unsigned int factorizations = 0;
+    bool         fell_back      = false;
+    /// The law residual after the solve (dem/law_residual.h), max |phi| / mean loaded
+    /// impulse: the same measure whatever the method.
+    double law_residual = 0;
     /// Convergence checks done: passes of local solves that apply nothing, one every
     /// `check_interval` sweeps (their cost is part of the solver's time).
     unsigned int check_passes = 0;
-    /// With NlgsParameters::threads > 1: whether the bands were solved concurrently
+    /// With SolverParameters::threads > 1: whether the bands were solved concurrently
     /// (false: they shared a body and were solved serially, in the same order).
     bool concurrent = false;
     bool         converged  = true;
@@ -179,20 +212,20 @@ namespace tribo::dem
   class NlgsSolver
   {
   public:
-    explicit NlgsSolver(const NlgsParameters &p = {});
+    explicit NlgsSolver(const SolverParameters &p = {});
     /// Solve for the impulses of @p contacts (warm-started from their r, whose
     /// effect must already be in @p state), updating @p state. @p theta_h = theta h
-    /// turns velocity violations into gap violations for NlgsParameters::gap_tolerance.
-    NlgsReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law,
+    /// turns velocity violations into gap violations for SolverParameters::gap_tolerance.
+    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law,
                      double theta_h = 0);
 
-    const NlgsParameters &parameters() const { return prm; }
+    const SolverParameters &parameters() const { return prm; }
     /// The random generator's state as text (checkpoints), and its restoration.
     std::string random_state() const;
     void        set_random_state(const std::string &state);
 
   private:
-    NlgsParameters            prm;
+    SolverParameters            prm;
     std::mt19937              rng;
     std::vector<unsigned int> order;
   };

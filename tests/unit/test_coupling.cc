@@ -61,7 +61,7 @@ TEST(Coupling, ElasticBlockOnGrainsCarriesThePressureAndBalancesEnergy)
   col.prm.rayleigh_mass = 2e8; // 1/s: settles within about 1e-8 s
   fem::ElasticBody       body(col.prm);
   coupling::ElasticBoundary boundary(body);
-  dem::NlgsParameters    nlgs;
+  dem::SolverParameters    nlgs;
   nlgs.tolerance = 1e-8;
   nlgs.check_interval = 1;
   dem::MoreauJean mj(0.5, dem::ContactLaw{}, nlgs, 0.05 * l);
@@ -231,7 +231,7 @@ TEST(Coupling, GrainsSlidingUnderAShiftedFaceAreNeverLost)
       prm.rayleigh_mass      = 2e8;
       fem::ElasticBody    body(prm);
       ShiftedBoundary     boundary(body);
-      dem::NlgsParameters nlgs;
+      dem::SolverParameters nlgs;
       nlgs.tolerance      = 1e-6;
       nlgs.check_interval = 1;
       const double    distance = 0.05 * l;

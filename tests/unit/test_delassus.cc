@@ -58,7 +58,7 @@ namespace
       for (auto &d : system.bodies[2].drive)
         d = Drive::velocity;
       system.bodies[1].angle = 0.05;
-      MoreauJean mj(0.5, ContactLaw{}, NlgsParameters{}, 0.5e-6);
+      MoreauJean mj(0.5, ContactLaw{}, SolverParameters{}, 0.5e-6);
       mj.step(system, 1e-12); // builds the contacts with their arms
       contacts = mj.contacts();
       state    = BodyState::of(system);

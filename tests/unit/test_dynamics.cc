@@ -13,9 +13,9 @@ namespace
 {
   const double rho = 7800, r = 0.6e-6;
 
-  NlgsParameters tight()
+  SolverParameters tight()
   {
-    NlgsParameters p;
+    SolverParameters p;
     p.tolerance      = 1e-6;
     p.check_interval = 1;
     return p;
@@ -202,7 +202,7 @@ TEST(Dynamics, NlgsSolutionSatisfiesSignorini)
   // contacts through the imposed-velocity wall), so a few steps may reach the sweep
   // cap. The velocities must satisfy Signorini either way.
   ParticleSystem s = squeezed_layer();
-  NlgsParameters prm = tight();
+  SolverParameters prm = tight();
   prm.max_iterations = 20000;
   MoreauJean     mj(0.5, ContactLaw{}, prm, 5e-8);
   const double   h = 1e-9;

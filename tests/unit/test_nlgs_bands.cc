@@ -1,4 +1,4 @@
-// The banded NLGS (NlgsParameters::threads > 1) and the interleaved streams: each is the
+// The banded NLGS (SolverParameters::threads > 1) and the interleaved streams: each is the
 // serial Gauss-Seidel sweep in its own order, bit for bit, and a banded run keeps the
 // energy balance of every step.
 #include "dem/moreau_jean.h"
@@ -53,7 +53,7 @@ namespace
     std::vector<Contact> contacts;
     ColdStart()
     {
-      NlgsParameters prm;
+      SolverParameters prm;
       prm.tolerance = 1e-3;
       MoreauJean mj(0.5, law, prm, 5e-8);
       for (int i = 0; i < 20; ++i)
@@ -65,9 +65,9 @@ namespace
   };
 
   /// Exactly @p sweeps sweeps (a tolerance never met).
-  NlgsParameters fixed_sweeps(unsigned int sweeps)
+  SolverParameters fixed_sweeps(unsigned int sweeps)
   {
-    NlgsParameters p;
+    SolverParameters p;
     p.tolerance      = 1e-300;
     p.max_iterations = sweeps;
     return p;
@@ -80,14 +80,14 @@ TEST(NlgsBands, ConcurrentSweepIsTheSerialSweepInBandOrder)
   const ParticleSystem       &s        = cold.system;
   const std::vector<Contact> &contacts = cold.contacts;
   ASSERT_GT(contacts.size(), 300u);
-  NlgsParameters fixed = fixed_sweeps(40);
+  SolverParameters fixed = fixed_sweeps(40);
   fixed.check_interval = 10;
   fixed.threads        = 2;
   fixed.streams        = 1; // the band order alone (streams reorder within a band)
 
   std::vector<Contact> banded = contacts;
   BodyState            banded_state = BodyState::of(s);
-  const NlgsReport     rep          = NlgsSolver(fixed).solve(banded, banded_state, cold.law);
+  const SolveReport     rep          = NlgsSolver(fixed).solve(banded, banded_state, cold.law);
   EXPECT_TRUE(rep.concurrent);
   EXPECT_EQ(rep.iterations, 40u);
 
@@ -120,7 +120,7 @@ TEST(NlgsBands, ConcurrentSweepIsTheSerialSweepInBandOrder)
 TEST(NlgsBands, RunKeepsTheEnergyBalanceOfEveryStep)
 {
   ParticleSystem s = tall_layer();
-  NlgsParameters prm;
+  SolverParameters prm;
   prm.tolerance = 1e-4;
   prm.threads   = 2;
   MoreauJean   mj(0.5, ContactLaw{}, prm, 5e-8);
@@ -146,7 +146,7 @@ TEST(NlgsBands, StreamsAreTheSerialSweepInInterleavedOrder)
   const ColdStart             cold;
   const ParticleSystem       &s        = cold.system;
   const std::vector<Contact> &contacts = cold.contacts;
-  NlgsParameters              fixed    = fixed_sweeps(40);
+  SolverParameters              fixed    = fixed_sweeps(40);
   fixed.streams                        = 4;
   fixed.stream_spacing                 = 16;
   std::vector<Contact> streamed = contacts;

@@ -66,7 +66,7 @@ namespace
     coupling::check_first_body(p);
     auto body = coupling::make_first_body(p);
 
-    dem::NlgsParameters nlgs;
+    dem::SolverParameters nlgs;
     nlgs.tolerance = 1e-8;
     nlgs.check_interval = 1;
     dem::MoreauJean mj(0.5, dem::ContactLaw{}, nlgs, 0.05 * s);

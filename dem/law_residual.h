@@ -1,0 +1,42 @@
+#pragma once
+/// @file A solver-independent accuracy measure of a contact solve: how far the impulses
+/// and the velocities they produce are from the contact law (docs/laws.md, "Law residual").
+///
+/// For contact i with shifted normal impulse r~ = r_n + gamma h (N s/m), the law's normal
+/// velocity u~ = u_n + b + c r~ (m/s; b the law's shift: IQS gap term max(0, g)/(theta h),
+/// ELAS g/(theta h); c the ELAS compliance 1/(theta k h^2), 0 for IQS) and
+/// rho = 1 / (W_nn + c) (N s/m per m/s), the natural map of the complementarity
+/// 0 <= r~ _|_ u~ >= 0 is
+///     phi_n = r~ - max(0, r~ - rho u~)                      (N s/m),
+/// zero exactly when the law holds. With Coulomb friction mu, rho_t = 1 / W_tt and
+///     phi_t = r_t - proj_[-mu r~', mu r~'](r_t - rho_t u_t),  r~' = max(0, r~ - rho u~),
+/// the Alart-Curnier map of the sliding law. The relative residual is
+///     max_i |phi_i| / mean over loaded contacts (r~ > 0) of r~,
+/// so 1e-4 means the worst contact is one ten-thousandth of a mean impulse from its law.
+/// The gap violation is theta h max(0, -(u_n + b)) over the IQS contacts (m): how far the
+/// end-of-step gap is left below what the law allows.
+
+#include "dem/contact.h"
+#include "dem/contact_law.h"
+
+#include <vector>
+
+namespace tribo::dem
+{
+  struct BodyState;
+
+  /// The law residual of a set of contacts (see the file comment).
+  struct LawResidual
+  {
+    double relative      = 0; ///< max |phi| / mean loaded r~, dimensionless
+    double max_phi       = 0; ///< max |phi| = max sqrt(phi_n^2 + phi_t^2), N s/m
+    double mean_impulse  = 0; ///< mean r~ over the contacts with r~ > 0, N s/m
+    double gap_violation = 0; ///< theta h max(0, -(u_n + b)) over IQS contacts, m
+    unsigned int worst   = 0; ///< index of the contact with the largest |phi|
+  };
+
+  /// The residual of @p contacts (impulses c.r, law terms) against the velocities of
+  /// @p state; @p theta_h = theta h (s) turns velocity violations into gap violations.
+  LawResidual law_residual(const std::vector<Contact> &contacts, const BodyState &state,
+                           const ContactLaw &law, double theta_h);
+} // namespace tribo::dem

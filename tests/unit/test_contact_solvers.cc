@@ -1,0 +1,210 @@
+// The sparse Delassus operator, the law residual and the active-set method against
+// the dense operator, closed forms and NLGS converged to 1e-12.
+#include "dem/delassus.h"
+#include "dem/law_residual.h"
+#include "dem/moreau_jean.h"
+
+#include <Eigen/Dense>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace tribo::dem;
+
+namespace
+{
+  const double rho = 7800, radius = 0.5e-6, h = 1e-9;
+
+  /// A hyperstatic packing: three hexagonal rows of four discs (six neighbours each) in
+  /// a periodic cell four diameters wide, on a fixed wall clump, under a wall clump
+  /// free in y and pushed down by @p load (N/m), the lower wall sliding at @p slide m/s.
+  ParticleSystem hexagonal_stack(double load, double slide)
+  {
+    ParticleSystem s;
+    const double   d = 2 * radius, row = d * std::sqrt(3.0) / 2;
+    s.period         = 4 * d;
+    std::vector<Vec2>   wall;
+    std::vector<double> radii(4, radius);
+    for (int i = 0; i < 4; ++i)
+      wall.push_back({(i + 0.5) * d, 0});
+    const unsigned lower = s.add_clump(wall, radii, rho);
+    for (auto &k : s.bodies[lower].drive)
+      k = Drive::velocity;
+    s.bodies[lower].velocity = {slide, 0};
+    for (int j = 1; j <= 3; ++j)
+      for (int i = 0; i < 4; ++i)
+        s.add_disc({(i + (j % 2 ? 1.0 : 0.5)) * d, j * row}, radius, rho);
+    for (auto &p : wall)
+      p = {p.x() + (4 % 2 ? 0.5 * d : 0.0), 4 * row};
+    const unsigned upper   = s.add_clump(wall, radii, rho);
+    s.bodies[upper].drive  = {{Drive::velocity, Drive::force, Drive::velocity}};
+    s.bodies[upper].load[1] = -load;
+    return s;
+  }
+
+  SolverParameters nlgs_converged()
+  {
+    SolverParameters p;
+    p.tolerance      = 1e-12;
+    p.check_interval = 1;
+    p.max_iterations = 200000;
+    return p;
+  }
+
+  SolverParameters active_set()
+  {
+    SolverParameters p;
+    p.method = SolverParameters::Method::active_set;
+    return p;
+  }
+
+  /// Velocities (v_x, v_y, spin) of every body after @p steps steps with @p prm.
+  Eigen::VectorXd velocities_after(ParticleSystem s, const ContactLaw &law,
+                                   const SolverParameters &prm, int steps,
+                                   std::vector<SolveReport> *reports = nullptr)
+  {
+    MoreauJean mj(0.5, law, prm, 0.1 * radius);
+    for (int i = 0; i < steps; ++i)
+      {
+        const auto rep = mj.step(s, h);
+        if (reports)
+          reports->push_back(rep.solver);
+      }
+    Eigen::VectorXd v(3 * s.bodies.size());
+    for (std::size_t b = 0; b < s.bodies.size(); ++b)
+      v.segment<3>(3 * b) << s.bodies[b].velocity, s.bodies[b].spin;
+    return v;
+  }
+} // namespace
+
+TEST(ContactSolvers, SparseDelassusEqualsTheDenseOperator)
+{
+  // W_ij from the exchange of impulses through the bodies (BodyState, tested against
+  // the dense H^T M^-1 H in test_delassus.cc), column by column.
+  ParticleSystem s = hexagonal_stack(100, 1);
+  MoreauJean     mj(0.5, ContactLaw{}, SolverParameters{}, 0.1 * radius);
+  mj.step(s, h);
+  const std::vector<Contact> &contacts = mj.contacts();
+  ASSERT_GE(contacts.size(), 30u);
+  const BodyState                   state = BodyState::of(s);
+  const Eigen::SparseMatrix<double> W     = assemble_delassus(contacts, state, DelassusPart::full);
+  const Eigen::SparseMatrix<double> Wn    = assemble_delassus(contacts, state, DelassusPart::normal);
+  Eigen::MatrixXd                   exchanged(2 * contacts.size(), 2 * contacts.size());
+  for (std::size_t j = 0; j < contacts.size(); ++j)
+    for (int a = 0; a < 2; ++a)
+      {
+        BodyState       st = state;
+        Eigen::Vector2d r  = Eigen::Vector2d::Zero();
+        r[a]               = 1e-9;
+        st.apply_impulse(contacts[j], r);
+        for (std::size_t i = 0; i < contacts.size(); ++i)
+          exchanged.block<2, 1>(2 * i, 2 * j + a) =
+            (st.local_velocity(contacts[i]) - state.local_velocity(contacts[i])) / 1e-9;
+      }
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(W);
+  EXPECT_LT((dense - exchanged).norm(), 1e-9 * exchanged.norm());
+  EXPECT_LT((dense - dense.transpose()).norm(), 1e-12 * dense.norm());
+  for (std::size_t i = 0; i < contacts.size(); ++i)
+    {
+      EXPECT_NEAR(Wn.coeff(i, i), dense(2 * i, 2 * i), 1e-12 * dense(2 * i, 2 * i));
+      EXPECT_LT((dense.block<2, 2>(2 * i, 2 * i) - state.delassus_block(contacts[i])).norm(),
+                1e-12 * dense(2 * i, 2 * i));
+    }
+}
+
+TEST(ContactSolvers, LawResidualIsZeroWhenSolvedAndPositiveWhenAContactIsLeftUnsolved)
+{
+  ParticleSystem s = hexagonal_stack(400, 0);
+  const ContactLaw law;
+  MoreauJean     mj(0.5, law, active_set(), 0.1 * radius);
+  for (int i = 0; i < 20; ++i)
+    mj.step(s, h);
+  std::vector<Contact> contacts = mj.contacts();
+  BodyState            state    = BodyState::of(s);
+  const LawResidual    solved   = law_residual(contacts, state, law, 0.5 * h);
+  EXPECT_GT(solved.mean_impulse, 0.0);
+  EXPECT_LT(solved.relative, 1e-9);
+  EXPECT_LT(solved.gap_violation, 1e-9 * radius);
+  // Remove the impulse of the most loaded contact from it and from the bodies.
+  std::size_t loaded = 0;
+  for (std::size_t i = 0; i < contacts.size(); ++i)
+    if (contacts[i].r.x() > contacts[loaded].r.x())
+      loaded = i;
+  const Eigen::Vector2d r = contacts[loaded].r;
+  state.apply_impulse(contacts[loaded], -r);
+  contacts[loaded].r.setZero();
+  const LawResidual unsolved = law_residual(contacts, state, law, 0.5 * h);
+  EXPECT_GT(unsolved.relative, 0.1);
+  EXPECT_GT(unsolved.gap_violation, 0.0);
+}
+
+TEST(ContactSolvers, ActiveSetCarriesTheAppliedForceOfADiscOnAWall)
+{
+  // Closed form: a disc touching a fixed wall under a load F is held by r_n = h F.
+  ParticleSystem s;
+  const unsigned wall = s.add_clump({{-1e-6, 0}, {0, 0}, {1e-6, 0}}, {radius, radius, radius}, rho);
+  for (auto &k : s.bodies[wall].drive)
+    k = Drive::velocity;
+  const unsigned disc     = s.add_disc({0, 2 * radius}, radius, rho);
+  const double   F        = -120.0;
+  s.bodies[disc].drive[1] = Drive::force;
+  s.bodies[disc].load[1]  = F;
+  MoreauJean mj(0.5, ContactLaw{}, active_set(), 1e-8);
+  const auto report = mj.step(s, 1e-8);
+  EXPECT_TRUE(report.solver.converged);
+  EXPECT_FALSE(report.solver.fell_back);
+  EXPECT_GE(report.solver.factorizations, 1u);
+  EXPECT_NEAR(mj.contact_force()[disc].y(), -F, 1e-9 * std::abs(F));
+  EXPECT_LT(report.solver.law_residual, 1e-12);
+}
+
+TEST(ContactSolvers, ActiveSetMatchesConvergedNlgsOnAHyperstaticStack)
+{
+  // Six contacts per disc: the impulses are not unique, the velocities are.
+  const ParticleSystem s = hexagonal_stack(400, 2);
+  std::vector<SolveReport> reports;
+  const Eigen::VectorXd    v_as   = velocities_after(s, ContactLaw{}, active_set(), 40, &reports);
+  const Eigen::VectorXd    v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 40);
+  EXPECT_LT((v_as - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
+  for (const auto &r : reports)
+    {
+      EXPECT_TRUE(r.converged);
+      EXPECT_FALSE(r.fell_back);
+      EXPECT_LT(r.law_residual, 1e-9);
+    }
+}
+
+TEST(ContactSolvers, ActiveSetMatchesConvergedNlgsOnACohesiveClusterAndWithElas)
+{
+  ContactLaw cohesive;
+  cohesive.cohesion       = 50;
+  cohesive.cohesion_range = 0.05 * radius;
+  ContactLaw elas;
+  elas.type      = ContactLaw::Type::elas;
+  elas.stiffness = 1e12;
+  for (const ContactLaw &law : {cohesive, elas})
+    {
+      // Unloaded upper wall lifted away: the cohesive bonds hold the grains to the walls.
+      ParticleSystem s = hexagonal_stack(law.cohesion > 0 ? -200 : 400, 1);
+      std::vector<SolveReport> reports;
+      const Eigen::VectorXd v_as   = velocities_after(s, law, active_set(), 30, &reports);
+      const Eigen::VectorXd v_nlgs = velocities_after(s, law, nlgs_converged(), 30);
+      EXPECT_LT((v_as - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << "cohesion " << law.cohesion;
+      for (const auto &r : reports)
+        EXPECT_LT(r.law_residual, 1e-9);
+    }
+}
+
+TEST(ContactSolvers, ActiveSetWithFrictionUsesNlgs)
+{
+  ContactLaw law;
+  law.friction = 0.3;
+  std::vector<SolveReport> reports;
+  velocities_after(hexagonal_stack(400, 2), law, active_set(), 5, &reports);
+  for (const auto &r : reports)
+    {
+      EXPECT_EQ(r.factorizations, 0u);
+      EXPECT_GT(r.iterations, 0u);
+    }
+}
