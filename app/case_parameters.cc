@@ -62,18 +62,19 @@ namespace tribo::app
     prm.enter_subsection("Solver");
     prm.declare_entry("Method", "nlgs", Selection("nlgs|active-set"),
                       "Contact solver: 'nlgs' (nonlinear Gauss-Seidel, the entries below) or "
-                      "'active-set' (primal-dual active-set Newton method on the frictionless "
-                      "problem, the sparse Delassus operator factorised by CHOLMOD, exact up to "
-                      "round-off; with friction the steps use NLGS and the log says so). "
+                      "'active-set' (projected Newton method on the frictionless problem, the "
+                      "sparse Delassus operator factorised by CHOLMOD, to 1e-11 of the mean impulse; "
+                      "with friction the steps use NLGS and the log says so). "
                       "docs/performance.md compares them.");
-    prm.declare_entry("Regularization", "1e-10", Double(),
-                      "Active set: relative regularisation delta in [0, 1e-4]: W_SS + delta diag(W_SS) "
-                      "is factorised (redundant contacts make W_SS singular).");
+    prm.declare_entry("Regularization", "1e-8", Double(),
+                      "Active set: relative regularisation delta in [0, 1e-4] of the Newton matrix "
+                      "W_FF + delta diag(W_FF) (redundant contacts make W_FF singular); it changes "
+                      "the Newton step, not the solution.");
     prm.declare_entry("Predictor sweeps", "10", Integer(0),
-                      "Active set: NLGS sweeps that predict the active set before the Newton "
-                      "iterations, >= 0.");
+                      "Active set: NLGS sweeps before the Newton iterations, >= 0.");
     prm.declare_entry("Maximum factorizations", "50", Integer(1),
-                      "Active set: Newton iterations per step before finishing with NLGS, >= 1.");
+                      "Active set: Newton iterations (factorisations) per step before the step is "
+                      "solved by NLGS instead, >= 1.");
     prm.declare_entry("Tolerance", "1e-4", Double(), "NLGS tolerance, > 0 (relative, see Norm).");
     prm.declare_entry("Norm", "Quad", Selection("Quad|Maxm"),
                       "Convergence norm of the established NSCD code: 'Quad' (mean-square) or "

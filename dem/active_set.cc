@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tribo::dem
 {
@@ -56,97 +57,78 @@ namespace tribo::dem
       loaded ? loaded_sum / loaded : std::max(1e-300, b.cwiseAbs().cwiseQuotient(diag).mean());
     const double tolerance = prm.feasibility_tolerance * scale;
 
-    std::vector<char> active(n);
-    Eigen::VectorXd   w = A * x + b;
-    for (Eigen::Index i = 0; i < n; ++i)
-      active[i] = x[i] - w[i] / diag[i] > 0;
-
-    // The matrix factorised: A_SS + delta D_SS on the active rows and columns (D the
-    // diagonal of A), the diagonal alone on the others (x_I = 0), on the pattern of A.
+    // Projected Newton iterations (Bertsekas 1982) on f(x) = x.A x / 2 + b.x, x >= 0,
+    // whose minimum is the LCP's solution; w = A x + b is f's gradient.
+    auto energy = [&](const Eigen::VectorXd &y, const Eigen::VectorXd &gy) {
+      return 0.5 * y.dot(gy + b); // y.A y / 2 + b.y with gy = A y + b
+    };
+    // The natural map max |min(x, w / D)|: zero at the solution.
+    auto natural_map = [&](const Eigen::VectorXd &y, const Eigen::VectorXd &gy) {
+      double worst = 0;
+      for (Eigen::Index i = 0; i < n; ++i)
+        worst = std::max(worst, std::abs(std::min(y[i], gy[i] / diag[i])));
+      return worst;
+    };
     Eigen::SparseMatrix<double> M = A;
     Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
     cholesky.analyzePattern(M);
-    const double    delta  = prm.regularization;
-    Eigen::VectorXd centre = x, rhs(n), w_reg(n);
-    unsigned int    best = n + 1, since_best = 0, solves = 0;
-    bool            factorised = false;
-    std::vector<Eigen::Index> infeasible;
+    const double      delta = prm.regularization;
+    Eigen::VectorXd   w     = A * x + b, rhs(n), d(n), trial(n), w_trial(n);
+    std::vector<char> free_dof(n);
+    double            last_worst = std::numeric_limits<double>::infinity();
     for (;;)
       {
-        if (!factorised)
-          {
-            if (report.factorizations >= prm.max_factorizations)
-              {
-                // Leave the warm start in place for the caller's NLGS.
-                report.converged  = false;
-
-                return report;
-              }
-            for (Eigen::Index j = 0; j < n; ++j)
-              for (Eigen::SparseMatrix<double>::InnerIterator a(A, j), m(M, j); a; ++a, ++m)
-                {
-                  const Eigen::Index i = a.row();
-                  if (i == j)
-                    m.valueRef() = active[j] ? a.value() * (1 + delta) : a.value();
-                  else
-                    m.valueRef() = active[i] && active[j] ? a.value() : 0.0;
-                }
-            cholesky.factorize(M);
-            ++report.factorizations;
-            if (cholesky.info() != Eigen::Success)
-              throw RunError("the active-set method could not factorise the Delassus operator of "
-                             "the loaded contacts (Solver/Regularization too small?)");
-            factorised = true;
-          }
-        // The proximal subproblem: A_SS x_S + b_S + delta D_SS (x_S - centre_S) = 0.
-        for (Eigen::Index i = 0; i < n; ++i)
-          rhs[i] = active[i] ? -b[i] + delta * diag[i] * centre[i] : 0.0;
-        x = cholesky.solve(rhs);
-        ++solves;
-        for (Eigen::Index i = 0; i < n; ++i)
-          if (!active[i])
-            x[i] = 0;
-        w     = A * x + b;
-        w_reg = w + delta * diag.cwiseProduct(x - centre);
-
-        infeasible.clear();
-        for (Eigen::Index i = 0; i < n; ++i)
-          if (active[i] ? x[i] < -tolerance : w_reg[i] < -tolerance * diag[i])
-            infeasible.push_back(i);
-        if (!infeasible.empty())
-          {
-            // Block principal pivoting on the proximal subproblem.
-            if (infeasible.size() < best)
-              {
-                best       = infeasible.size();
-                since_best = 0;
-              }
-            else
-              ++since_best;
-            if (since_best < 3)
-              for (const Eigen::Index i : infeasible)
-                active[i] = !active[i];
-            else
-              active[infeasible.back()] = !active[infeasible.back()]; // Murty's rule
-            factorised = false;
-            continue;
-          }
-        // The subproblem is solved; is the problem itself? Natural map min(x, w / D).
-        double worst = 0;
-        for (Eigen::Index i = 0; i < n; ++i)
-          worst = std::max(worst, std::abs(std::min(x[i], w[i] / diag[i])));
+        const double worst = natural_map(x, w);
         if (worst <= tolerance)
           break;
-        if (solves >= prm.max_proximal_steps)
+        // Round-off floor: within 1000 times the target, an iteration that does not halve
+        // the natural map ends the solve (the energy no longer tells the iterates apart).
+        if (worst <= 1e3 * tolerance && worst >= 0.5 * last_worst)
+          break;
+        last_worst = worst;
+        if (report.factorizations >= prm.max_factorizations)
           {
-            report.converged  = false;
-
-            return report;
+            report.converged = false;
+            return report; // the warm start is untouched: the caller solves with NLGS
           }
-        centre = x; // the next proximal step, on the same factorisation
-        best   = n + 1;
+        // Binding contacts: at (or within eps of) zero impulse with an opening gradient;
+        // the others are free and take the Newton step of the reduced problem.
+        const double eps = std::min(worst, scale);
+        for (Eigen::Index i = 0; i < n; ++i)
+          free_dof[i] = !(x[i] <= eps && w[i] > 0);
+        for (Eigen::Index j = 0; j < n; ++j)
+          for (Eigen::SparseMatrix<double>::InnerIterator a(A, j), m(M, j); a; ++a, ++m)
+            {
+              const Eigen::Index i = a.row();
+              if (i == j)
+                m.valueRef() = free_dof[j] ? a.value() * (1 + delta) : a.value();
+              else
+                m.valueRef() = free_dof[i] && free_dof[j] ? a.value() : 0.0;
+            }
+        cholesky.factorize(M);
+        ++report.factorizations;
+        if (cholesky.info() != Eigen::Success)
+          throw RunError("the active-set method could not factorise the Delassus operator of "
+                         "the loaded contacts (Solver/Regularization too small?)");
+        for (Eigen::Index i = 0; i < n; ++i)
+          rhs[i] = -w[i];
+        d = cholesky.solve(rhs); // free: -(A_FF + delta D)^-1 w_F; binding: -w_B / D_B
+        // Armijo search along the projection arc x(alpha) = max(0, x + alpha d); the full
+        // step is also taken when it halves the natural map (near the solution the energy's
+        // round-off hides the decrease).
+        const double f0    = energy(x, w);
+        double       alpha = 1;
+        for (int k = 0; k < 30; ++k, alpha *= 0.5)
+          {
+            trial   = (x + alpha * d).cwiseMax(0.0);
+            w_trial = A * trial + b;
+            if (energy(trial, w_trial) <= f0 + 1e-4 * w.dot(trial - x) ||
+                (k == 0 && natural_map(trial, w_trial) <= 0.5 * worst))
+              break;
+          }
+        x = trial;
+        w = w_trial;
       }
-
     // Impulses (x >= 0: round-off projected) and the body velocities they produce.
     for (Eigen::Index i = 0; i < n; ++i)
       {
@@ -158,7 +140,7 @@ namespace tribo::dem
         c.r = r_new;
       }
 
-    report.converged  = true;
+    report.converged = true;
     return report;
   }
 } // namespace tribo::dem

@@ -35,32 +35,27 @@ namespace tribo::dem
   /// Controls of the contact solve: the method, and the NLGS's own controls.
   struct SolverParameters
   {
-    /// The method: nonlinear Gauss-Seidel (below), or the primal-dual active-set
-    /// (semismooth Newton) method on the frictionless problem with the sparse Delassus
-    /// operator factorised by CHOLMOD (dem/active_set.h; with friction the step uses
-    /// NLGS and says so).
+    /// The method: nonlinear Gauss-Seidel (below), or the active-set (projected Newton)
+    /// method on the frictionless problem with the sparse Delassus operator factorised
+    /// by CHOLMOD (dem/active_set.h; with friction the step uses NLGS and says so).
     enum class Method
     {
       nlgs,
       active_set
     };
     Method method = Method::nlgs;
-    /// Active set: relative proximal regularisation delta, W_SS + delta diag(W_SS) is
-    /// factorised (redundant, hyperstatic contacts make W_SS singular) and proximal steps
-    /// remove its effect (dem/active_set.h).
-    double regularization = 1e-6;
-    /// Active set: NLGS sweeps before the Newton iterations, predicting the active set
-    /// (0: the warm start's prediction alone).
+    /// Active set: relative regularisation delta of the Newton matrix W_FF + delta
+    /// diag(W_FF) (redundant, hyperstatic contacts make W_FF singular; it changes the step,
+    /// not the solution).
+    double regularization = 1e-8;
+    /// Active set: NLGS sweeps before the Newton iterations (0: none).
     unsigned int predictor_sweeps = 10;
-    /// Active set: proximal steps (solves) per step before finishing with NLGS.
-    unsigned int max_proximal_steps = 200;
-    /// Active set: factorisations per step before falling back to NLGS from its best
-    /// iterate.
+    /// Active set: factorisations per step before the step is solved by NLGS instead.
     unsigned int max_factorizations = 50;
-    /// Active set: a contact is infeasible when its impulse is below -tau x_mean or its
-    /// law velocity below -tau x_mean W_nn, x_mean the mean loaded impulse of the warm
-    /// start (round-off in an ill-conditioned W_SS must not flip contacts back and forth).
-    double feasibility_tolerance = 1e-10;
+    /// Active set: the solve ends when the natural map max |min(x, w / W_nn)| is below
+    /// this times the warm start's mean loaded impulse x_mean, or below 1000 times that
+    /// when an iteration no longer halves it (round-off).
+    double feasibility_tolerance = 1e-11;
     enum class Norm
     {
       quad,

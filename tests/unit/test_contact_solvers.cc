@@ -150,7 +150,9 @@ TEST(ContactSolvers, ActiveSetCarriesTheAppliedForceOfADiscOnAWall)
   const double   F        = -120.0;
   s.bodies[disc].drive[1] = Drive::force;
   s.bodies[disc].load[1]  = F;
-  MoreauJean mj(0.5, ContactLaw{}, active_set(), 1e-8);
+  SolverParameters newton = active_set();
+  newton.predictor_sweeps = 0; // the Newton iterations alone
+  MoreauJean mj(0.5, ContactLaw{}, newton, 1e-8);
   const auto report = mj.step(s, 1e-8);
   EXPECT_TRUE(report.solver.converged);
   EXPECT_FALSE(report.solver.fell_back);
@@ -175,25 +177,50 @@ TEST(ContactSolvers, ActiveSetMatchesConvergedNlgsOnAHyperstaticStack)
     }
 }
 
-TEST(ContactSolvers, ActiveSetMatchesConvergedNlgsOnACohesiveClusterAndWithElas)
+TEST(ContactSolvers, ActiveSetMatchesConvergedNlgsOnACohesiveCluster)
 {
-  ContactLaw cohesive;
-  cohesive.cohesion       = 50;
-  cohesive.cohesion_range = 0.05 * radius;
-  ContactLaw elas;
-  elas.type      = ContactLaw::Type::elas;
-  elas.stiffness = 1e12;
-  for (const ContactLaw &law : {cohesive, elas})
+  // Upper wall pulled away: the cohesive bonds hold the grains to both walls.
+  ContactLaw law;
+  law.cohesion       = 50;
+  law.cohesion_range = 0.05 * radius;
+  std::vector<SolveReport> reports;
+  const ParticleSystem     s      = hexagonal_stack(-200, 1);
+  const Eigen::VectorXd    v_as   = velocities_after(s, law, active_set(), 30, &reports);
+  const Eigen::VectorXd    v_nlgs = velocities_after(s, law, nlgs_converged(), 30);
+  EXPECT_LT((v_as - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
+  for (const auto &r : reports)
     {
-      // Unloaded upper wall lifted away: the cohesive bonds hold the grains to the walls.
-      ParticleSystem s = hexagonal_stack(law.cohesion > 0 ? -200 : 400, 1);
-      std::vector<SolveReport> reports;
-      const Eigen::VectorXd v_as   = velocities_after(s, law, active_set(), 30, &reports);
-      const Eigen::VectorXd v_nlgs = velocities_after(s, law, nlgs_converged(), 30);
-      EXPECT_LT((v_as - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << "cohesion " << law.cohesion;
-      for (const auto &r : reports)
-        EXPECT_LT(r.law_residual, 1e-9);
+      EXPECT_FALSE(r.fell_back);
+      EXPECT_LT(r.law_residual, 1e-9);
     }
+}
+
+TEST(ContactSolvers, ActiveSetWithElasMatchesConvergedNlgs)
+{
+  // ELAS shifts every near contact by g / (theta h): on this stack the projected Newton
+  // iterations converge only linearly in some steps, which then finish with NLGS (here
+  // converged to 1e-12 too): the result must not depend on it, and most steps must not
+  // need it.
+  ContactLaw law;
+  law.type      = ContactLaw::Type::elas;
+  law.stiffness = 1e12;
+  SolverParameters prm = nlgs_converged();
+  prm.method           = SolverParameters::Method::active_set;
+  std::vector<SolveReport> reports;
+  const ParticleSystem     s      = hexagonal_stack(400, 1);
+  const Eigen::VectorXd    v_as   = velocities_after(s, law, prm, 30, &reports);
+  const Eigen::VectorXd    v_nlgs = velocities_after(s, law, nlgs_converged(), 30);
+  EXPECT_LT((v_as - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
+  unsigned fallbacks = 0;
+  for (const auto &r : reports)
+    {
+      fallbacks += r.fell_back;
+      if (!r.fell_back)
+        {
+          EXPECT_LT(r.law_residual, 1e-9);
+        }
+    }
+  EXPECT_LE(fallbacks, 10u);
 }
 
 TEST(ContactSolvers, ActiveSetWithFrictionUsesNlgs)
