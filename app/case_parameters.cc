@@ -60,18 +60,23 @@ namespace tribo::app
     prm.leave_subsection();
 
     prm.enter_subsection("Solver");
-    prm.declare_entry("Method", "nlgs", Selection("nlgs|active-set"),
-                      "Contact solver: 'nlgs' (nonlinear Gauss-Seidel, the entries below) or "
+    prm.declare_entry("Method", "nlgs", Selection("nlgs|active-set|mprgp"),
+                      "Contact solver: 'nlgs' (nonlinear Gauss-Seidel, the entries below), "
                       "'active-set' (projected Newton method on the frictionless problem, the "
-                      "sparse Delassus operator factorised by CHOLMOD, to 1e-11 of the mean impulse; "
-                      "with friction the steps use NLGS and the log says so). "
-                      "docs/performance.md compares them.");
+                      "sparse Delassus operator factorised by CHOLMOD) or 'mprgp' (matrix-free "
+                      "projected conjugate gradient with proportioning, on both cores with "
+                      "Threads = 2). The last two stop at Residual target; with friction their "
+                      "steps use NLGS and the log says so. docs/performance.md compares them.");
+    prm.declare_entry("Residual target", "1e-11", Double(),
+                      "Active set and MPRGP: the solve ends when the law residual, max over "
+                      "contacts of |min(r~, u~ / W_nn)| over the mean loaded impulse r~ "
+                      "(dimensionless, docs/laws.md), is below this, in (0, 1).");
     prm.declare_entry("Regularization", "1e-8", Double(),
                       "Active set: relative regularisation delta in [0, 1e-4] of the Newton matrix "
                       "W_FF + delta diag(W_FF) (redundant contacts make W_FF singular); it changes "
                       "the Newton step, not the solution.");
     prm.declare_entry("Predictor sweeps", "10", Integer(0),
-                      "Active set: NLGS sweeps before the Newton iterations, >= 0.");
+                      "Active set and MPRGP: NLGS sweeps before their iterations, >= 0.");
     prm.declare_entry("Maximum factorizations", "50", Integer(1),
                       "Active set: Newton iterations (factorisations) per step before the step is "
                       "solved by NLGS instead, >= 1.");
@@ -81,7 +86,9 @@ namespace tribo::app
                       "'Maxm' (maximum over contacts).");
     prm.declare_entry("Relaxation", "1", Double(), "Relaxation omega in (0, 1]: r = omega r_law + (1 - omega) r_old.");
     prm.declare_entry("Check interval", "10", Integer(1), "Sweeps between convergence checks, >= 1.");
-    prm.declare_entry("Maximum iterations", "10000", Integer(1), "Maximum number of sweeps per step, >= 1.");
+    prm.declare_entry("Maximum iterations", "10000", Integer(1),
+                      "Maximum number of sweeps per step (MPRGP: products with the Delassus "
+                      "operator), >= 1.");
     prm.declare_entry("Contact order", "fixed", Selection("fixed|alternating|random"),
                       "Order of the local solves: 'fixed' (detection order: cells by rows, bottom to "
                       "top), 'alternating' (that order and its reverse in turn, a symmetric Gauss-Seidel) "
@@ -234,8 +241,12 @@ namespace tribo::app
     p.detection_distance =
       f.get_checked("Contact law/Detection distance", non_negative, "a distance >= 0 in m");
 
-    p.solver.method = f.get("Solver/Method") == "active-set" ? dem::SolverParameters::Method::active_set
-                                                           : dem::SolverParameters::Method::nlgs;
+    const std::string method = f.get("Solver/Method");
+    p.solver.method = method == "active-set" ? dem::SolverParameters::Method::active_set
+                      : method == "mprgp"    ? dem::SolverParameters::Method::mprgp
+                                             : dem::SolverParameters::Method::nlgs;
+    p.solver.residual_target = f.get_checked("Solver/Residual target", [](double v) { return v > 0 && v < 1; },
+                                             "a relative residual in (0, 1)");
     p.solver.regularization = f.get_checked("Solver/Regularization", [](double v) { return v >= 0 && v <= 1e-4; },
                                             "a regularisation in [0, 1e-4]");
     p.solver.max_factorizations = f.get_integer("Solver/Maximum factorizations");

@@ -368,8 +368,9 @@ namespace tribo::app
       log(os.str());
       if (!scene->description().empty())
         log(scene->description());
-      if (p.solver.method == dem::SolverParameters::Method::active_set && p.law.friction > 0)
-        log("Solver/Method = active-set solves frictionless problems only: with Coulomb friction (mu = " +
+      if (p.solver.method != dem::SolverParameters::Method::nlgs && p.law.friction > 0)
+        log("Solver/Method = " + dem::method_name(p.solver.method) +
+            " solves frictionless problems only: with Coulomb friction (mu = " +
             std::to_string(p.law.friction) + ") every step uses NLGS");
     }
     // What building the case cost: the modules a case does not use are not built (a rigid
@@ -526,8 +527,7 @@ namespace tribo::app
     summary.set("law_residual_max", max_law_residual);
     summary.set("law_residual_mean", step ? sum_law_residual / step : 0.0);
     summary.set("gap_violation_max", max_gap_violation);
-    summary.set("solver_method", p.solver.method == dem::SolverParameters::Method::active_set
-                                   ? std::string("active-set") : std::string("nlgs"));
+    summary.set("solver_method", dem::method_name(p.solver.method));
     summary.set("factorizations_mean", step ? double(total_factorizations) / step : 0.0);
     summary.set("active_set_fallbacks", long(fallbacks));
     summary.set("max_overlap", worst_overlap);
@@ -568,7 +568,10 @@ namespace tribo::app
 
     std::ostringstream os;
     os << "status " << status << ": " << step << " steps in " << wall << " s, "
-       << (step ? double(total_iterations) / step : 0.0) << " NLGS sweeps per step, "
+       << (step ? double(total_iterations) / step : 0.0)
+       << (p.solver.method == dem::SolverParameters::Method::mprgp ? " NLGS sweeps and MPRGP products"
+                                                                   : " NLGS sweeps")
+       << " per step, "
        << non_converged << " steps not converged, law residual mean "
        << (step ? sum_law_residual / step : 0.0) << " max " << max_law_residual
        << ", worst overlap " << worst_overlap << " m";

@@ -1,7 +1,7 @@
 #include "dem/active_set.h"
 
 #include "core/errors.h"
-#include "dem/delassus.h"
+#include "dem/frictionless_problem.h"
 
 #include <Eigen/CholmodSupport>
 
@@ -26,49 +26,15 @@ namespace tribo::dem
       throw RunError("the active-set method solves frictionless problems only (Coulomb friction "
                      "mu = " + std::to_string(law.friction) + ")");
 
-    // The LCP 0 <= x _|_ w = A x + b >= 0 (file comment).
-    Eigen::SparseMatrix<double> A = assemble_delassus(contacts, state, DelassusPart::normal);
-    Eigen::VectorXd             gh(n), b(n), x(n), diag(n);
-    for (Eigen::Index i = 0; i < n; ++i)
-      {
-        const Contact &c = contacts[i];
-        gh[i]            = c.cohesion_impulse;
-        b[i]             = c.u_free.x() + c.shift;
-        x[i]             = std::max(0.0, c.r.x() + c.cohesion_impulse);
-      }
-    b -= A * gh;
-    for (Eigen::Index i = 0; i < n; ++i)
-      {
-        A.coeffRef(i, i) += contacts[i].compliance;
-        diag[i] = A.coeff(i, i);
-      }
-
-    // Scale of the impulses for the tests: the mean warm-started impulse of the loaded
-    // contacts (or of |b_i| / A_ii without one).
-    double       loaded_sum = 0;
-    unsigned int loaded     = 0;
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (x[i] > 0)
-        {
-          loaded_sum += x[i];
-          ++loaded;
-        }
-    const double scale =
-      loaded ? loaded_sum / loaded : std::max(1e-300, b.cwiseAbs().cwiseQuotient(diag).mean());
-    const double tolerance = prm.feasibility_tolerance * scale;
+    FrictionlessProblem   lcp(contacts, state);
+    const Eigen::SparseMatrix<double> &A = lcp.A;
+    const Eigen::VectorXd             &b = lcp.b;
+    Eigen::VectorXd       x = lcp.x;
+    const double          scale     = lcp.scale;
+    const double          tolerance = prm.residual_target * scale;
 
     // Projected Newton iterations (Bertsekas 1982) on f(x) = x.A x / 2 + b.x, x >= 0,
     // whose minimum is the LCP's solution; w = A x + b is f's gradient.
-    auto energy = [&](const Eigen::VectorXd &y, const Eigen::VectorXd &gy) {
-      return 0.5 * y.dot(gy + b); // y.A y / 2 + b.y with gy = A y + b
-    };
-    // The natural map max |min(x, w / D)|: zero at the solution.
-    auto natural_map = [&](const Eigen::VectorXd &y, const Eigen::VectorXd &gy) {
-      double worst = 0;
-      for (Eigen::Index i = 0; i < n; ++i)
-        worst = std::max(worst, std::abs(std::min(y[i], gy[i] / diag[i])));
-      return worst;
-    };
     Eigen::SparseMatrix<double> M = A;
     Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
     cholesky.analyzePattern(M);
@@ -78,7 +44,7 @@ namespace tribo::dem
     double            last_worst = std::numeric_limits<double>::infinity();
     for (;;)
       {
-        const double worst = natural_map(x, w);
+        const double worst = lcp.natural_map(x, w);
         if (worst <= tolerance)
           break;
         // Round-off floor: within 1000 times the target, an iteration that does not halve
@@ -116,30 +82,20 @@ namespace tribo::dem
         // Armijo search along the projection arc x(alpha) = max(0, x + alpha d); the full
         // step is also taken when it halves the natural map (near the solution the energy's
         // round-off hides the decrease).
-        const double f0    = energy(x, w);
+        const double f0    = lcp.energy(x, w);
         double       alpha = 1;
         for (int k = 0; k < 30; ++k, alpha *= 0.5)
           {
             trial   = (x + alpha * d).cwiseMax(0.0);
             w_trial = A * trial + b;
-            if (energy(trial, w_trial) <= f0 + 1e-4 * w.dot(trial - x) ||
-                (k == 0 && natural_map(trial, w_trial) <= 0.5 * worst))
+            if (lcp.energy(trial, w_trial) <= f0 + 1e-4 * w.dot(trial - x) ||
+                (k == 0 && lcp.natural_map(trial, w_trial) <= 0.5 * worst))
               break;
           }
         x = trial;
         w = w_trial;
       }
-    // Impulses (x >= 0: round-off projected) and the body velocities they produce.
-    for (Eigen::Index i = 0; i < n; ++i)
-      {
-        Contact              &c = contacts[i];
-        const Eigen::Vector2d r_new(std::max(0.0, x[i]) - gh[i], 0.0);
-        const Eigen::Vector2d dr = r_new - c.r;
-        if (dr.x() != 0 || dr.y() != 0)
-          state.apply_impulse(c, dr);
-        c.r = r_new;
-      }
-
+    lcp.apply(x, contacts, state);
     report.converged = true;
     return report;
   }

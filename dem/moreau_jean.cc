@@ -20,6 +20,7 @@ namespace tribo::dem
     , contact_law(law)
     , solver(solver)
     , active_set(solver)
+    , mprgp(solver)
     , predictor([&] {
       SolverParameters p = solver;
       p.max_iterations   = std::max(1U, solver.predictor_sweeps);
@@ -46,6 +47,38 @@ namespace tribo::dem
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
   } // namespace
+
+  bool MoreauJean::global_method() const
+  {
+    return solver.parameters().method != SolverParameters::Method::nlgs && contact_law.friction <= 0;
+  }
+
+  SolveReport MoreauJean::solve_contacts(double h)
+  {
+    if (!global_method())
+      return solver.solve(current, state, contact_law, th * h);
+    const SolverParameters &controls = solver.parameters();
+    unsigned int            sweeps   = 0;
+    if (controls.predictor_sweeps > 0)
+      sweeps = predictor.solve(current, state, contact_law, th * h).iterations;
+    if (controls.method == SolverParameters::Method::mprgp)
+      {
+        SolveReport report = mprgp.solve(current, state, contact_law);
+        report.iterations += sweeps;
+        return report;
+      }
+    SolveReport        report         = active_set.solve(current, state, contact_law);
+    const unsigned int factorizations = report.factorizations;
+    if (!report.converged)
+      {
+        // Not found within its budget: NLGS from the predictor's impulses.
+        report           = solver.solve(current, state, contact_law, th * h);
+        report.fell_back = true;
+      }
+    report.factorizations = factorizations;
+    report.iterations += sweeps;
+    return report;
+  }
 
   StepReport MoreauJean::step(ParticleSystem &system, double h)
   {
@@ -146,31 +179,12 @@ namespace tribo::dem
         state.apply_impulse(c, c.r);
 
     phase              = std::chrono::steady_clock::now();
-    const SolverParameters &controls = solver.parameters();
-    if (controls.method == SolverParameters::Method::active_set && contact_law.friction <= 0)
-      {
-        unsigned int sweeps = 0;
-        if (controls.predictor_sweeps > 0)
-          sweeps = predictor.solve(current, state, contact_law, th * h).iterations;
-        report.solver            = active_set.solve(current, state, contact_law);
-        const unsigned int factorizations = report.solver.factorizations;
-        if (!report.solver.converged)
-          {
-            // Not found within its budget: NLGS from the predictor's impulses.
-            report.solver           = solver.solve(current, state, contact_law, th * h);
-            report.solver.fell_back = true;
-          }
-        report.solver.factorizations = factorizations;
-        report.solver.iterations += sweeps;
-      }
-    else
-      report.solver = solver.solve(current, state, contact_law, th * h);
+    report.solver      = solve_contacts(h);
     report.time_solver = seconds_since(phase);
     const LawResidual accuracy   = law_residual(current, state, contact_law, th * h);
     report.solver.law_residual  = accuracy.relative;
     report.solver.gap_violation = accuracy.gap_violation;
-    if (controls.method == SolverParameters::Method::active_set && !report.solver.fell_back &&
-        contact_law.friction <= 0)
+    if (global_method() && !report.solver.fell_back)
       report.solver.residual = accuracy.relative;
 
     // Gap measures with the final velocities.

@@ -4,7 +4,7 @@
 /// - free velocity: v_free = v_i + h M^-1 F_ext (constant imposed loads);
 /// - detection at the predicted configuration q_pred = q_i + (1 - theta) h v_i;
 /// - local problems u = W r + u_free with W = H^T M^-1 H, solved by NLGS or the
-///   active-set method (SolverParameters::method);
+///   active-set method or MPRGP (SolverParameters::method);
 /// - velocity v_{i+1} = v_free + M^-1 H r, position q_{i+1} = q_pred + theta h v_{i+1}.
 /// Imposed-velocity dofs keep their velocity. Impulses are warm-started from
 /// the previous step's contact between the same two discs.
@@ -13,6 +13,7 @@
 #include "dem/boundary.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
+#include "dem/mprgp.h"
 #include "dem/nlgs.h"
 #include "dem/particle_system.h"
 
@@ -119,10 +120,18 @@ namespace tribo::dem
     void load(CheckpointIn &ar);
 
   private:
+    /// Whether the step is solved by a global method (active set, MPRGP): chosen, and
+    /// the law frictionless.
+    bool global_method() const;
+    /// The contact impulses of the current step by the chosen method (its predictor
+    /// sweeps included), updating state.
+    SolveReport solve_contacts(double h);
+
     double                   th;
     ContactLaw               contact_law;
     NlgsSolver               solver;
     ActiveSetSolver          active_set;
+    MprgpSolver              mprgp;
     NlgsSolver               predictor; ///< the active set's predictor sweeps
     double                   distance;
     ContactDetector          detector;

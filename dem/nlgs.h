@@ -35,27 +35,30 @@ namespace tribo::dem
   /// Controls of the contact solve: the method, and the NLGS's own controls.
   struct SolverParameters
   {
-    /// The method: nonlinear Gauss-Seidel (below), or the active-set (projected Newton)
-    /// method on the frictionless problem with the sparse Delassus operator factorised
-    /// by CHOLMOD (dem/active_set.h; with friction the step uses NLGS and says so).
+    /// The method: nonlinear Gauss-Seidel (below); on the frictionless problem, the
+    /// active-set (projected Newton) method with the sparse Delassus operator factorised
+    /// by CHOLMOD (dem/active_set.h) or the matrix-free MPRGP (dem/mprgp.h). With
+    /// friction the global methods hand the step to NLGS and say so.
     enum class Method
     {
       nlgs,
-      active_set
+      active_set,
+      mprgp
     };
     Method method = Method::nlgs;
     /// Active set: relative regularisation delta of the Newton matrix W_FF + delta
     /// diag(W_FF) (redundant, hyperstatic contacts make W_FF singular; it changes the step,
     /// not the solution).
     double regularization = 1e-8;
-    /// Active set: NLGS sweeps before the Newton iterations (0: none).
+    /// Active set and MPRGP: NLGS sweeps before their iterations (0: none).
     unsigned int predictor_sweeps = 10;
     /// Active set: factorisations per step before the step is solved by NLGS instead.
     unsigned int max_factorizations = 50;
-    /// Active set: the solve ends when the natural map max |min(x, w / W_nn)| is below
-    /// this times the warm start's mean loaded impulse x_mean, or below 1000 times that
-    /// when an iteration no longer halves it (round-off).
-    double feasibility_tolerance = 1e-11;
+    /// Active set and MPRGP: the solve ends when the natural map max |min(x, w / W_nn)|
+    /// (dem/frictionless_problem.h) is below this times the warm start's mean loaded
+    /// impulse x_mean (the active set also stops below 1000 times that when an iteration
+    /// no longer halves it: round-off).
+    double residual_target = 1e-11;
     enum class Norm
     {
       quad,
@@ -106,6 +109,20 @@ namespace tribo::dem
     /// step (docs/laws.md).
     double gap_tolerance = 0;
   };
+
+  /// The name of @p method as Solver/Method spells it.
+  inline std::string method_name(SolverParameters::Method method)
+  {
+    switch (method)
+      {
+        case SolverParameters::Method::active_set:
+          return "active-set";
+        case SolverParameters::Method::mprgp:
+          return "mprgp";
+        default:
+          return "nlgs";
+      }
+  }
 
   /// What one solve achieved.
   struct SolveReport

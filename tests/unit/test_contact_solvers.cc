@@ -59,6 +59,15 @@ namespace
     return p;
   }
 
+  /// The global methods, each to a law residual of 1e-11 (MPRGP: up to 1e5 products).
+  std::vector<SolverParameters> global_methods()
+  {
+    SolverParameters mprgp;
+    mprgp.method         = SolverParameters::Method::mprgp;
+    mprgp.max_iterations = 100000;
+    return {active_set(), mprgp};
+  }
+
   /// Velocities (v_x, v_y, spin) of every body after @p steps steps with @p prm.
   Eigen::VectorXd velocities_after(ParticleSystem s, const ContactLaw &law,
                                    const SolverParameters &prm, int steps,
@@ -139,63 +148,76 @@ TEST(ContactSolvers, LawResidualIsZeroWhenSolvedAndPositiveWhenAContactIsLeftUns
   EXPECT_GT(unsolved.gap_violation, 0.0);
 }
 
-TEST(ContactSolvers, ActiveSetCarriesTheAppliedForceOfADiscOnAWall)
+TEST(ContactSolvers, GlobalMethodsCarryTheAppliedForceOfADiscOnAWall)
 {
   // Closed form: a disc touching a fixed wall under a load F is held by r_n = h F.
-  ParticleSystem s;
-  const unsigned wall = s.add_clump({{-1e-6, 0}, {0, 0}, {1e-6, 0}}, {radius, radius, radius}, rho);
-  for (auto &k : s.bodies[wall].drive)
-    k = Drive::velocity;
-  const unsigned disc     = s.add_disc({0, 2 * radius}, radius, rho);
-  const double   F        = -120.0;
-  s.bodies[disc].drive[1] = Drive::force;
-  s.bodies[disc].load[1]  = F;
-  SolverParameters newton = active_set();
-  newton.predictor_sweeps = 0; // the Newton iterations alone
-  MoreauJean mj(0.5, ContactLaw{}, newton, 1e-8);
-  const auto report = mj.step(s, 1e-8);
-  EXPECT_TRUE(report.solver.converged);
-  EXPECT_FALSE(report.solver.fell_back);
-  EXPECT_GE(report.solver.factorizations, 1u);
-  EXPECT_NEAR(mj.contact_force()[disc].y(), -F, 1e-9 * std::abs(F));
-  EXPECT_LT(report.solver.law_residual, 1e-12);
-}
-
-TEST(ContactSolvers, ActiveSetMatchesConvergedNlgsOnAHyperstaticStack)
-{
-  // Six contacts per disc: the impulses are not unique, the velocities are.
-  const ParticleSystem s = hexagonal_stack(400, 2);
-  std::vector<SolveReport> reports;
-  const Eigen::VectorXd    v_as   = velocities_after(s, ContactLaw{}, active_set(), 40, &reports);
-  const Eigen::VectorXd    v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 40);
-  EXPECT_LT((v_as - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
-  for (const auto &r : reports)
+  for (SolverParameters prm : global_methods())
     {
-      EXPECT_TRUE(r.converged);
-      EXPECT_FALSE(r.fell_back);
-      EXPECT_LT(r.law_residual, 1e-9);
+      ParticleSystem s;
+      const unsigned wall = s.add_clump({{-1e-6, 0}, {0, 0}, {1e-6, 0}}, {radius, radius, radius}, rho);
+      for (auto &k : s.bodies[wall].drive)
+        k = Drive::velocity;
+      const unsigned disc     = s.add_disc({0, 2 * radius}, radius, rho);
+      const double   F        = -120.0;
+      s.bodies[disc].drive[1] = Drive::force;
+      s.bodies[disc].load[1]  = F;
+      prm.predictor_sweeps    = 0; // the method's own iterations alone
+      MoreauJean mj(0.5, ContactLaw{}, prm, 1e-8);
+      const auto report = mj.step(s, 1e-8);
+      const std::string name = method_name(prm.method);
+      EXPECT_TRUE(report.solver.converged) << name;
+      EXPECT_FALSE(report.solver.fell_back) << name;
+      if (prm.method == SolverParameters::Method::active_set)
+        EXPECT_GE(report.solver.factorizations, 1u);
+      else
+        EXPECT_GE(report.solver.iterations, 1u);
+      EXPECT_NEAR(mj.contact_force()[disc].y(), -F, 1e-9 * std::abs(F)) << name;
+      EXPECT_LT(report.solver.law_residual, 1e-12) << name;
     }
 }
 
-TEST(ContactSolvers, ActiveSetMatchesConvergedNlgsOnACohesiveCluster)
+TEST(ContactSolvers, GlobalMethodsMatchConvergedNlgsOnAHyperstaticStack)
+{
+  // Six contacts per disc: the impulses are not unique, the velocities are.
+  const ParticleSystem  s      = hexagonal_stack(400, 2);
+  const Eigen::VectorXd v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 40);
+  for (const SolverParameters &prm : global_methods())
+    {
+      std::vector<SolveReport> reports;
+      const Eigen::VectorXd    v = velocities_after(s, ContactLaw{}, prm, 40, &reports);
+      EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << method_name(prm.method);
+      for (const auto &r : reports)
+        {
+          EXPECT_TRUE(r.converged);
+          EXPECT_FALSE(r.fell_back);
+          EXPECT_LT(r.law_residual, 1e-9) << method_name(prm.method);
+        }
+    }
+}
+
+TEST(ContactSolvers, GlobalMethodsMatchConvergedNlgsOnACohesiveCluster)
 {
   // Upper wall pulled away: the cohesive bonds hold the grains to both walls.
   ContactLaw law;
   law.cohesion       = 50;
   law.cohesion_range = 0.05 * radius;
-  std::vector<SolveReport> reports;
-  const ParticleSystem     s      = hexagonal_stack(-200, 1);
-  const Eigen::VectorXd    v_as   = velocities_after(s, law, active_set(), 30, &reports);
-  const Eigen::VectorXd    v_nlgs = velocities_after(s, law, nlgs_converged(), 30);
-  EXPECT_LT((v_as - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
-  for (const auto &r : reports)
+  const ParticleSystem  s      = hexagonal_stack(-200, 1);
+  const Eigen::VectorXd v_nlgs = velocities_after(s, law, nlgs_converged(), 30);
+  for (const SolverParameters &prm : global_methods())
     {
-      EXPECT_FALSE(r.fell_back);
-      EXPECT_LT(r.law_residual, 1e-9);
+      std::vector<SolveReport> reports;
+      const Eigen::VectorXd    v = velocities_after(s, law, prm, 30, &reports);
+      EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << method_name(prm.method);
+      for (const auto &r : reports)
+        {
+          EXPECT_TRUE(r.converged);
+          EXPECT_FALSE(r.fell_back);
+          EXPECT_LT(r.law_residual, 1e-9) << method_name(prm.method);
+        }
     }
 }
 
-TEST(ContactSolvers, ActiveSetWithElasMatchesConvergedNlgs)
+TEST(ContactSolvers, GlobalMethodsWithElasMatchConvergedNlgs)
 {
   // ELAS shifts every near contact by g / (theta h): on this stack the projected Newton
   // iterations converge only linearly in some steps, which then finish with NLGS (here
@@ -221,17 +243,32 @@ TEST(ContactSolvers, ActiveSetWithElasMatchesConvergedNlgs)
         }
     }
   EXPECT_LE(fallbacks, 10u);
+  // MPRGP: the compliance makes A better conditioned, no fallback exists or is needed.
+  SolverParameters mprgp = global_methods()[1];
+  reports.clear();
+  const Eigen::VectorXd v_mprgp = velocities_after(s, law, mprgp, 30, &reports);
+  EXPECT_LT((v_mprgp - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
+  for (const auto &r : reports)
+    {
+      EXPECT_TRUE(r.converged);
+      EXPECT_LT(r.law_residual, 1e-9);
+    }
 }
 
-TEST(ContactSolvers, ActiveSetWithFrictionUsesNlgs)
+TEST(ContactSolvers, GlobalMethodsWithFrictionUseNlgs)
 {
   ContactLaw law;
   law.friction = 0.3;
-  std::vector<SolveReport> reports;
-  velocities_after(hexagonal_stack(400, 2), law, active_set(), 5, &reports);
-  for (const auto &r : reports)
+  for (const SolverParameters &prm : global_methods())
     {
-      EXPECT_EQ(r.factorizations, 0u);
-      EXPECT_GT(r.iterations, 0u);
+      std::vector<SolveReport> reports;
+      const Eigen::VectorXd v     = velocities_after(hexagonal_stack(400, 2), law, prm, 5, &reports);
+      const Eigen::VectorXd v_ref = velocities_after(hexagonal_stack(400, 2), law, SolverParameters{}, 5);
+      EXPECT_EQ(v, v_ref) << method_name(prm.method);
+      for (const auto &r : reports)
+        {
+          EXPECT_EQ(r.factorizations, 0u);
+          EXPECT_GT(r.iterations, 0u);
+        }
     }
 }

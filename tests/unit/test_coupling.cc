@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -89,6 +90,63 @@ TEST(Coupling, ElasticBlockOnGrainsCarriesThePressureAndBalancesEnergy)
   // (within 5 %: the bottom is loaded at 8 points, not uniformly).
   const Eigen::Matrix2d eps = body.strain_at({0.5 * L, col.prm.bottom + 0.5 * col.prm.thickness});
   EXPECT_NEAR(eps(1, 1), -P / (body.lame_lambda() + 2 * body.shear_modulus()), 0.05 * P / (body.lame_lambda() + 2 * body.shear_modulus()));
+}
+
+TEST(Coupling, GlobalContactSolversMatchConvergedNlgsAgainstTheElasticBlock)
+{
+  // The half-disc contacts couple through the block's condensed compliance (dense
+  // blocks of the sparse Delassus operator): the active set and MPRGP, to a law
+  // residual of 1e-11, give NLGS's history (converged to 1e-12) while the wall under the
+  // grains slides at 1 m/s and the block takes its load: the wall's reaction, the grains'
+  // kinetic energy and the block's energy at every step.
+  using History = std::vector<std::array<double, 3>>;
+  auto run      = [](const dem::SolverParameters &prm, std::vector<dem::StepReport> &reports) {
+    Column col;
+    col.prm.rayleigh_mass            = 2e8;
+    col.s.bodies[col.wall].velocity = {1.0, 0.0}; // the wall slides: the grains move
+    fem::ElasticBody          body(col.prm);
+    coupling::ElasticBoundary boundary(body);
+    dem::MoreauJean           mj(0.5, dem::ContactLaw{}, prm, 0.05 * l);
+    mj.attach(boundary, l, {0, -1}, L);
+    History history;
+    for (int i = 0; i < 60; ++i)
+      {
+        reports.push_back(mj.step(col.s, 1e-9));
+        history.push_back({{mj.contact_force()[col.wall].y(), reports.back().kinetic_energy,
+                            reports.back().boundary_energy}});
+      }
+    return history;
+  };
+  dem::SolverParameters nlgs;
+  nlgs.tolerance      = 1e-12;
+  nlgs.check_interval = 1;
+  nlgs.max_iterations = 100000;
+  std::vector<dem::StepReport> ignored;
+  const History                reference = run(nlgs, ignored);
+  std::array<double, 3>        scale{};
+  for (const auto &row : reference)
+    for (int k = 0; k < 3; ++k)
+      scale[k] = std::max(scale[k], std::abs(row[k]));
+  ASSERT_GT(scale[0], 0.5 * P * L);
+  ASSERT_GT(scale[1], 0.0);
+  for (const auto method : {dem::SolverParameters::Method::active_set, dem::SolverParameters::Method::mprgp})
+    {
+      dem::SolverParameters prm = nlgs;
+      prm.method                = method;
+      std::vector<dem::StepReport> reports;
+      const History                history = run(prm, reports);
+      const std::string            name    = dem::method_name(method);
+      for (std::size_t i = 0; i < history.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+          EXPECT_NEAR(history[i][k], reference[i][k], 1e-6 * scale[k])
+            << name << ", step " << i << ", quantity " << k;
+      for (const auto &r : reports)
+        {
+          EXPECT_EQ(r.n_boundary_contacts, 8u) << name;
+          EXPECT_FALSE(r.solver.fell_back) << name;
+          EXPECT_LT(r.solver.law_residual, 1e-8) << name; // the active set's round-off floor
+        }
+    }
 }
 
 TEST(Coupling, StiffBlockMovesLikeARigidBody)

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Contact solvers side by side from one checkpoint: each setting resumes a copy of the run
+# for STEPS steps and prints its time per step (summary.json "timing": the steps alone,
+# no start-up), the solver's share, iterations per step (NLGS sweeps, predictor sweeps
+# plus MPRGP products), CHOLMOD factorisations per step, the law residual reached (mean
+# and max over the steps, docs/laws.md), the worst overlap over the smallest radius, and
+# mean mu. Run it on an otherwise idle machine; settings are timed in turn, in one sitting.
+#
+#   bash bench/solver_methods.sh RUN_DIR STEPS "SETTING" ["SETTING" ...]
+#
+# RUN_DIR: a shear run with a checkpoint.bin (Output/Checkpoint step interval); a SETTING
+# is a space-separated list of Section/Entry=value, e.g.
+#   bash bench/solver_methods.sh out/rb 100 "Solver/Method=nlgs" \
+#       "Solver/Method=mprgp Solver/Residual target=1e-3 Solver/Threads=2"
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+tribo=${TRIBO:-$here/build/bin/tribo}
+[ $# -ge 3 ] || { echo "usage: $0 RUN_DIR STEPS SETTING [SETTING ...]" >&2; exit 2; }
+[ -f "$1/checkpoint.bin" ] || { echo "$0: $1: no checkpoint.bin" >&2; exit 2; }
+exec /usr/bin/python3 - "$tribo" "$@" <<'PY'
+import csv, json, os, re, shutil, subprocess, sys, tempfile
+
+tribo, src, steps, settings = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
+fixed = ["Output/Field interval=0", "Output/Plots=false", "Output/Statistics interval=1",
+         "Output/Checkpoint interval=0", "Output/Checkpoint step interval=0"]
+
+
+def resume(end, dst, extra):
+    shutil.rmtree(dst, ignore_errors=True)
+    shutil.copytree(src, dst)
+    args = [tribo, "run", os.path.join(dst, "parameters.prm"), "--resume", dst, "--quiet"]
+    for s in fixed + ["Simulation/End time=%.17g" % end] + extra:
+        args += ["--set", s]
+    subprocess.run(args, check=True, capture_output=True)
+    step0 = int(re.findall(r"resumed at step (\d+)", open(os.path.join(dst, "log.txt")).read())[-1])
+    return step0, json.load(open(os.path.join(dst, "summary.json")))
+
+
+prm = open(os.path.join(src, "parameters.prm")).read()
+h = float(re.search(r"set Time step\s*=\s*(\S+)", prm).group(1))
+r_min = None
+m = re.search(r"set Mean diameter\s*=\s*(\S+)", prm)
+spread = re.search(r"set Diameter spread\s*=\s*(\S+)", prm)
+if m and spread:
+    r_min = float(m.group(1)) * (1 - float(spread.group(1))) / 2
+tmp = tempfile.mkdtemp()
+try:
+    dst = os.path.join(tmp, "run")
+    step0, _ = resume(1e-12, dst, [])  # logs the checkpoint's step, runs nothing
+    print(f"checkpoint {src} at step {step0}, {steps} steps per setting")
+    print("| setting | ms per step | solver ms | iterations per step | factorisations per step "
+          "| law residual mean / max | worst overlap / r_min | mean mu |")
+    print("|---|---|---|---|---|---|---|---|")
+    for setting in settings:
+        extra = [s.strip() for s in re.split(r"\s+(?=[A-Z][A-Za-z ]*/)", setting.strip()) if s.strip()]
+        _, s = resume((step0 + steps) * h, dst, extra)
+        rows = [r for r in csv.DictReader(open(os.path.join(dst, "statistics.csv")))
+                if int(float(r["step"])) > step0]
+        t = s["timing"]
+        lr = [float(r["law_residual"]) for r in rows]
+        overlap = max(float(r["max_overlap"]) for r in rows)
+        mu = sum(float(r["mu"]) for r in rows) / len(rows)
+        print(f"| {setting} | {t['step_mean_s'] * 1e3:.1f} | {t['nlgs_mean_s'] * 1e3:.1f} "
+              f"| {t['nlgs_sweeps_mean']:.1f} | {s.get('factorizations_mean', 0):.1f} "
+              f"| {sum(lr) / len(lr):.2e} / {max(lr):.2e} "
+              f"| {overlap / r_min if r_min else float('nan'):.2f} | {mu:.4f} |", flush=True)
+finally:
+    shutil.rmtree(tmp)
+PY

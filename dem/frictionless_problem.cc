@@ -1,0 +1,93 @@
+#include "dem/frictionless_problem.h"
+
+#include "dem/delassus.h"
+#include "dem/nlgs.h"
+
+#include <deal.II/base/parallel.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace tribo::dem
+{
+  FrictionlessProblem::FrictionlessProblem(const std::vector<Contact> &contacts,
+                                           const BodyState            &state)
+    : A(assemble_delassus(contacts, state, DelassusPart::normal))
+  {
+    const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());
+    b.resize(n);
+    x.resize(n);
+    diagonal.resize(n);
+    cohesion.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+      {
+        const Contact &c = contacts[i];
+        cohesion[i]      = c.cohesion_impulse;
+        b[i]             = c.u_free.x() + c.shift;
+        x[i]             = std::max(0.0, c.r.x() + c.cohesion_impulse);
+      }
+    b -= A * cohesion;
+    for (Eigen::Index i = 0; i < n; ++i)
+      {
+        A.coeffRef(i, i) += contacts[i].compliance;
+        diagonal[i] = A.coeff(i, i);
+      }
+    A.makeCompressed(); // coeffRef inserts a missing diagonal entry uncompressed
+    double       loaded_sum = 0;
+    unsigned int loaded     = 0;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (x[i] > 0)
+        {
+          loaded_sum += x[i];
+          ++loaded;
+        }
+    scale = loaded    ? loaded_sum / loaded
+            : n > 0 ? std::max(1e-300, b.cwiseAbs().cwiseQuotient(diagonal).mean())
+                    : 1.0;
+  }
+
+  double FrictionlessProblem::natural_map(const Eigen::VectorXd &y, const Eigen::VectorXd &w) const
+  {
+    double worst = 0;
+    for (Eigen::Index i = 0; i < y.size(); ++i)
+      worst = std::max(worst, std::abs(std::min(y[i], w[i] / diagonal[i])));
+    return worst;
+  }
+
+  void FrictionlessProblem::apply(const Eigen::VectorXd &y, std::vector<Contact> &contacts,
+                                  BodyState &state) const
+  {
+    for (Eigen::Index i = 0; i < y.size(); ++i)
+      {
+        Contact              &c = contacts[i];
+        const Eigen::Vector2d r_new(std::max(0.0, y[i]) - cohesion[i], 0.0);
+        const Eigen::Vector2d dr = r_new - c.r;
+        if (dr.x() != 0 || dr.y() != 0)
+          state.apply_impulse(c, dr);
+        c.r = r_new;
+      }
+  }
+
+  void symmetric_product(const Eigen::SparseMatrix<double> &M, const Eigen::VectorXd &in,
+                         Eigen::VectorXd &out, unsigned int threads)
+  {
+    const Eigen::Index n = M.cols();
+    out.resize(n);
+    const int    *start = M.outerIndexPtr();
+    const int    *row   = M.innerIndexPtr();
+    const double *value = M.valuePtr();
+    auto columns = [&](Eigen::Index first, Eigen::Index last) {
+      for (Eigen::Index j = first; j < last; ++j)
+        {
+          double sum = 0;
+          for (int k = start[j]; k < start[j + 1]; ++k)
+            sum += value[k] * in[row[k]];
+          out[j] = sum;
+        }
+    };
+    if (threads <= 1 || n < 4096)
+      columns(0, n);
+    else
+      dealii::parallel::apply_to_subranges(Eigen::Index(0), n, columns, n / (4 * threads) + 1);
+  }
+} // namespace tribo::dem

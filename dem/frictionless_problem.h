@@ -1,0 +1,60 @@
+#pragma once
+/// @file The frictionless contact problem of a step as a linear complementarity problem,
+/// shared by the global solvers (dem/active_set.h, dem/mprgp.h).
+///
+/// With x = r~ = r_n + gamma h the shifted normal impulses (N s/m) and
+///     w = A x + b,  A = W_nn + C,  b = u_free,n + shift - W_nn (gamma h)
+/// the law's normal velocities (m/s; W_nn the normal part of the sparse Delassus operator,
+/// dem/delassus.h; C the diagonal ELAS compliances 1/(theta k h^2), 0 for IQS; shift the
+/// law's gap term, dem/contact_law.h), both IQS and ELAS are
+///     0 <= x  _|_  w >= 0,
+/// i.e. the minimum over x >= 0 of the contact energy f(x) = x.A x / 2 + b.x, whose
+/// gradient is w (A is symmetric positive semidefinite). The natural map
+///     phi_i = min(x_i, w_i / A_ii)      (N s/m)
+/// is zero exactly at a solution; it is the law residual's phi_n (dem/law_residual.h).
+
+#include "dem/contact.h"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <vector>
+
+namespace tribo::dem
+{
+  struct BodyState;
+
+  struct FrictionlessProblem
+  {
+    /// The problem of @p contacts against @p state, whose velocities must already hold the
+    /// contacts' warm-start impulses c.r; x starts at max(0, r_n + gamma h).
+    FrictionlessProblem(const std::vector<Contact> &contacts, const BodyState &state);
+
+    Eigen::SparseMatrix<double> A;  ///< W_nn + C, both triangles, column-major
+    Eigen::VectorXd b;              ///< m/s
+    Eigen::VectorXd x;              ///< the warm start, N s/m
+    Eigen::VectorXd diagonal;       ///< A_ii
+    Eigen::VectorXd cohesion;       ///< gamma h of each contact, N s/m
+    /// Scale of the impulses for relative tests: the warm start's mean loaded impulse,
+    /// or, without one, the mean of |b_i| / A_ii.
+    double scale = 0;
+
+    Eigen::Index size() const { return b.size(); }
+    /// max_i |min(y_i, w_i / A_ii)| with w = A y + b given, N s/m.
+    double natural_map(const Eigen::VectorXd &y, const Eigen::VectorXd &w) const;
+    /// f(y) = y.A y / 2 + b.y with w = A y + b given.
+    double energy(const Eigen::VectorXd &y, const Eigen::VectorXd &w) const
+    {
+      return 0.5 * y.dot(w + b);
+    }
+    /// Write the impulses r_n = max(0, y) - gamma h into @p contacts (r_t = 0) and apply
+    /// the change to @p state's velocities.
+    void apply(const Eigen::VectorXd &y, std::vector<Contact> &contacts, BodyState &state) const;
+  };
+
+  /// out = M in for a symmetric sparse @p M (column-major, both triangles), the columns
+  /// cut into @p threads ranges computed concurrently (TBB through deal.II): column j of
+  /// M is row j, so each range writes only its own entries of @p out.
+  void symmetric_product(const Eigen::SparseMatrix<double> &M, const Eigen::VectorXd &in,
+                         Eigen::VectorXd &out, unsigned int threads);
+} // namespace tribo::dem
