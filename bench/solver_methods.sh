@@ -37,10 +37,13 @@ def resume(end, dst, extra):
 
 
 prm = open(os.path.join(src, "parameters.prm")).read()
-h = float(re.search(r"set Time step\s*=\s*(\S+)", prm).group(1))
+simulation = re.search(r"^subsection Simulation$(.*?)^end$", prm, re.S | re.M).group(1)
+h = float(re.search(r"set Time step\s*=\s*(\S+)", simulation).group(1))
 r_min = None
-m = re.search(r"set Mean diameter\s*=\s*(\S+)", prm)
-spread = re.search(r"set Diameter spread\s*=\s*(\S+)", prm)
+shear = re.search(r"^subsection Shear cell$(.*?)^end$", prm, re.S | re.M)
+shear = shear.group(1) if shear else ""
+m = re.search(r"set Mean diameter\s*=\s*(\S+)", shear)
+spread = re.search(r"set Diameter spread\s*=\s*(\S+)", shear)
 if m and spread:
     r_min = float(m.group(1)) * (1 - float(spread.group(1))) / 2
 tmp = tempfile.mkdtemp()

@@ -47,9 +47,10 @@ namespace tribo::dem
         const double worst = lcp.natural_map(x, w);
         if (worst <= tolerance)
           break;
-        // Round-off floor: within 1000 times the target, an iteration that does not halve
-        // the natural map ends the solve (the energy no longer tells the iterates apart).
-        if (worst <= 1e3 * tolerance && worst >= 0.5 * last_worst)
+        // Round-off floor: below 1e-8 of the mean impulse, an iteration that does not
+        // halve the natural map ends the solve (the energy no longer tells the iterates
+        // apart).
+        if (worst <= 1e-8 * scale && worst >= 0.5 * last_worst)
           break;
         last_worst = worst;
         if (report.factorizations >= prm.max_factorizations)

@@ -3,8 +3,6 @@
 #include "dem/delassus.h"
 #include "dem/nlgs.h"
 
-#include <deal.II/base/parallel.h>
-
 #include <algorithm>
 #include <cmath>
 
@@ -66,28 +64,5 @@ namespace tribo::dem
           state.apply_impulse(c, dr);
         c.r = r_new;
       }
-  }
-
-  void symmetric_product(const Eigen::SparseMatrix<double> &M, const Eigen::VectorXd &in,
-                         Eigen::VectorXd &out, unsigned int threads)
-  {
-    const Eigen::Index n = M.cols();
-    out.resize(n);
-    const int    *start = M.outerIndexPtr();
-    const int    *row   = M.innerIndexPtr();
-    const double *value = M.valuePtr();
-    auto columns = [&](Eigen::Index first, Eigen::Index last) {
-      for (Eigen::Index j = first; j < last; ++j)
-        {
-          double sum = 0;
-          for (int k = start[j]; k < start[j + 1]; ++k)
-            sum += value[k] * in[row[k]];
-          out[j] = sum;
-        }
-    };
-    if (threads <= 1 || n < 4096)
-      columns(0, n);
-    else
-      dealii::parallel::apply_to_subranges(Eigen::Index(0), n, columns, n / (4 * threads) + 1);
   }
 } // namespace tribo::dem

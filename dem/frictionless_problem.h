@@ -52,9 +52,4 @@ namespace tribo::dem
     void apply(const Eigen::VectorXd &y, std::vector<Contact> &contacts, BodyState &state) const;
   };
 
-  /// out = M in for a symmetric sparse @p M (column-major, both triangles), the columns
-  /// cut into @p threads ranges computed concurrently (TBB through deal.II): column j of
-  /// M is row j, so each range writes only its own entries of @p out.
-  void symmetric_product(const Eigen::SparseMatrix<double> &M, const Eigen::VectorXd &in,
-                         Eigen::VectorXd &out, unsigned int threads);
 } // namespace tribo::dem

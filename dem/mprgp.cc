@@ -3,12 +3,70 @@
 #include "core/errors.h"
 #include "dem/frictionless_problem.h"
 
+#include <deal.II/base/parallel.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace tribo::dem
 {
+  namespace
+  {
+    using Index = Eigen::Index;
+
+    /// Entries per chunk of the fused passes: partial results are made per chunk and
+    /// added in chunk order, so the result is the same for any number of threads.
+    constexpr Index chunk_size = 256;
+
+    /// Run @p body(begin, end) -> Partial over fixed chunks of [0, n), concurrently when
+    /// @p threads > 1, and merge the partials in chunk order.
+    template <typename Partial, typename Body>
+    Partial over_chunks(Index n, unsigned int threads, const Body &body)
+    {
+      const Index          count = (n + chunk_size - 1) / chunk_size;
+      std::vector<Partial> partial(count);
+      auto                 work = [&](Index first, Index last) {
+        for (Index c = first; c < last; ++c)
+          partial[c] = body(c * chunk_size, std::min(n, (c + 1) * chunk_size));
+      };
+      if (threads > 1 && count > 1)
+        dealii::parallel::apply_to_subranges(Index(0), count, work, 1);
+      else
+        work(0, count);
+      Partial total;
+      for (const Partial &p : partial)
+        total.merge(p);
+      return total;
+    }
+
+    /// Reductions of a product pass: p.A'p, g.p and the largest feasible step along -p.
+    struct ProductSums
+    {
+      double pAp = 0, gp = 0, to_bound = std::numeric_limits<double>::infinity();
+      void   merge(const ProductSums &o)
+      {
+        pAp += o.pAp;
+        gp += o.gp;
+        to_bound = std::min(to_bound, o.to_bound);
+      }
+    };
+
+    /// Reductions of a split pass (file comment of mprgp.h): the natural map, ||beta||^2,
+    /// phi~.phi and phi.A'p.
+    struct SplitSums
+    {
+      double worst = 0, beta2 = 0, proportional = 0, phi_Ap = 0;
+      void   merge(const SplitSums &o)
+      {
+        worst = std::max(worst, o.worst);
+        beta2 += o.beta2;
+        proportional += o.proportional;
+        phi_Ap += o.phi_Ap;
+      }
+    };
+  } // namespace
+
   MprgpSolver::MprgpSolver(const SolverParameters &p)
     : prm(p)
   {}
@@ -24,125 +82,158 @@ namespace tribo::dem
                      std::to_string(law.friction) + ")");
 
     const FrictionlessProblem lcp(contacts, state);
-    const Eigen::Index        n = lcp.size();
+    const Index               n = lcp.size();
     // The scaled problem (file comment): A' = S A S, b' = S b, y = x / s, S = D^(-1/2).
-    const Eigen::VectorXd inv_root = lcp.diagonal.cwiseSqrt().cwiseInverse(); // S
-    Eigen::SparseMatrix<double> A = lcp.A;
-    for (Eigen::Index j = 0; j < n; ++j)
-      for (Eigen::SparseMatrix<double>::InnerIterator a(A, j); a; ++a)
-        a.valueRef() *= inv_root[a.row()] * inv_root[j];
-    const Eigen::VectorXd b = lcp.b.cwiseProduct(inv_root);
-    double                norm_bound = 0; // ||A'|| <= max absolute row (= column) sum
-    for (Eigen::Index j = 0; j < n; ++j)
+    const Eigen::VectorXd       inv_root = lcp.diagonal.cwiseSqrt().cwiseInverse(); // S
+    Eigen::SparseMatrix<double> A        = lcp.A;
+    double                      norm_bound = 0; // ||A'|| <= max absolute column sum
+    for (Index j = 0; j < n; ++j)
       {
         double sum = 0;
         for (Eigen::SparseMatrix<double>::InnerIterator a(A, j); a; ++a)
-          sum += std::abs(a.value());
+          {
+            a.valueRef() *= inv_root[a.row()] * inv_root[j];
+            sum += std::abs(a.value());
+          }
         norm_bound = std::max(norm_bound, sum);
       }
-    const double alpha     = 1.9 / norm_bound;
-    const double tolerance = prm.residual_target * lcp.scale;
-    const double gamma2    = 1.0; // Gamma^2
+    const Eigen::VectorXd b         = lcp.b.cwiseProduct(inv_root);
+    const double          alpha     = 1.9 / norm_bound;
+    const double          tolerance = prm.residual_target * lcp.scale;
+    const double          gamma2    = 1.0; // Gamma^2
+    const unsigned int    threads   = prm.threads;
+
+    // Column j of the symmetric A' is its row j: (A' v)_j from column j alone.
+    const int    *start = A.outerIndexPtr();
+    const int    *row   = A.innerIndexPtr();
+    const double *value = A.valuePtr();
+    auto          times = [&](const Eigen::VectorXd &v, Index j) {
+      double sum = 0;
+      for (int k = start[j]; k < start[j + 1]; ++k)
+        sum += value[k] * v[row[k]];
+      return sum;
+    };
 
     Eigen::VectorXd y = lcp.x.cwiseQuotient(inv_root), g(n), p(n), Ap(n), phi(n), beta(n);
-    auto product = [&](const Eigen::VectorXd &in, Eigen::VectorXd &out) {
-      symmetric_product(A, in, out, prm.threads);
-      ++report.iterations;
-    };
-    // phi, beta and the proportionality test's two sides; returns the natural map
-    // max |min(y_i, g_i)| / sqrt(D_i) (N s/m).
-    double beta2 = 0, proportional = 0;
-    auto   split = [&]() {
-      double worst = 0;
-      beta2 = proportional = 0;
-      for (Eigen::Index i = 0; i < n; ++i)
+    // phi_j, beta_j and the split sums of entry j; with @p Ap_known, also phi.A'p.
+    auto split_entry = [&](Index j, SplitSums &s, bool with_Ap) {
+      s.worst = std::max(s.worst, std::abs(std::min(y[j], g[j])) * inv_root[j]);
+      if (y[j] > 0)
         {
-          worst = std::max(worst, std::abs(std::min(y[i], g[i])) * inv_root[i]);
-          if (y[i] > 0)
-            {
-              phi[i]  = g[i];
-              beta[i] = 0;
-              proportional += std::min(y[i] / alpha, g[i]) * g[i];
-            }
-          else
-            {
-              phi[i]  = 0;
-              beta[i] = std::min(g[i], 0.0);
-              beta2 += beta[i] * beta[i];
-            }
+          phi[j]  = g[j];
+          beta[j] = 0;
+          s.proportional += std::min(y[j] / alpha, g[j]) * g[j];
+          if (with_Ap)
+            s.phi_Ap += phi[j] * Ap[j];
         }
-      return worst;
+      else
+        {
+          phi[j]  = 0;
+          beta[j] = std::min(g[j], 0.0);
+          s.beta2 += beta[j] * beta[j];
+        }
+    };
+    // g = A'y + b, then the split; p = phi.
+    auto gradient_and_split = [&]() {
+      ++report.iterations;
+      return over_chunks<SplitSums>(n, threads, [&](Index first, Index last) {
+        SplitSums s;
+        for (Index j = first; j < last; ++j)
+          {
+            g[j] = times(y, j) + b[j];
+            split_entry(j, s, false);
+            p[j] = phi[j];
+          }
+        return s;
+      });
+    };
+    // Ap = A' d and the product sums along d.
+    auto product = [&](const Eigen::VectorXd &d) {
+      ++report.iterations;
+      return over_chunks<ProductSums>(n, threads, [&](Index first, Index last) {
+        ProductSums s;
+        for (Index j = first; j < last; ++j)
+          {
+            Ap[j] = times(d, j);
+            s.pAp += d[j] * Ap[j];
+            s.gp += g[j] * d[j];
+            if (d[j] > 0)
+              s.to_bound = std::min(s.to_bound, y[j] / d[j]);
+          }
+        return s;
+      });
+    };
+    // y -= step d, g -= step A'd, then the split (with phi.A'p when @p cg).
+    auto move = [&](const Eigen::VectorXd &d, double step, bool cg) {
+      return over_chunks<SplitSums>(n, threads, [&](Index first, Index last) {
+        SplitSums s;
+        for (Index j = first; j < last; ++j)
+          {
+            y[j] -= step * d[j];
+            g[j] -= step * Ap[j];
+            split_entry(j, s, cg);
+          }
+        return s;
+      });
+    };
+    auto set_p = [&](double coeff) { // p = phi - coeff p
+      over_chunks<SplitSums>(n, threads, [&](Index first, Index last) {
+        for (Index j = first; j < last; ++j)
+          p[j] = phi[j] - coeff * p[j];
+        return SplitSums{};
+      });
     };
 
-    product(y, g);
-    g += b;
-    double worst = split();
-    p            = phi;
-    while (worst > tolerance)
+    SplitSums split = gradient_and_split();
+    while (split.worst > tolerance)
       {
         if (report.iterations >= prm.max_iterations)
           {
             report.converged = false;
             break;
           }
-        if (beta2 <= gamma2 * proportional)
+        if (split.beta2 <= gamma2 * split.proportional)
           {
-            product(p, Ap);
-            const double pAp = p.dot(Ap);
-            if (!(pAp > 0))
+            const ProductSums along = product(p);
+            // Along a direction of zero curvature (A' is singular for redundant contacts)
+            // f is linear: the step goes to the bound.
+            const double step = along.pAp > 0 ? along.gp / along.pAp
+                                              : std::numeric_limits<double>::infinity();
+            if (std::isinf(step) && std::isinf(along.to_bound))
               {
-                // p = 0 on a proportional iterate: the free part is solved; nothing
-                // more to gain along it (round-off), so take the gradient step.
-                p = phi;
-                if (p.squaredNorm() == 0)
-                  break;
-                continue;
+                report.converged = false; // f unbounded below along -p: cannot happen
+                break;                    // with a mobile body at every contact
               }
-            const double step = g.dot(p) / pAp;
-            double       to_bound = std::numeric_limits<double>::infinity();
-            for (Eigen::Index i = 0; i < n; ++i)
-              if (p[i] > 0)
-                to_bound = std::min(to_bound, y[i] / p[i]);
-            if (step <= to_bound)
+            if (step <= along.to_bound)
               {
                 // Conjugate-gradient step.
-                y -= step * p;
-                g -= step * Ap;
-                worst              = split();
-                const double coeff = phi.dot(Ap) / pAp;
-                p                  = phi - coeff * p;
+                split = move(p, step, true);
+                set_p(split.phi_Ap / along.pAp);
               }
             else
               {
-                // Expansion step: to the bound, then a fixed-length projected gradient step.
-                y -= to_bound * p;
-                g -= to_bound * Ap;
-                for (Eigen::Index i = 0; i < n; ++i)
-                  {
-                    const double free_gradient = y[i] > 0 ? g[i] : 0.0;
-                    y[i] = std::max(0.0, y[i] - alpha * free_gradient);
-                  }
-                product(y, g);
-                g += b;
-                worst = split();
-                p     = phi;
+                // Expansion step: to the bound along p, then the fixed-length projected
+                // gradient step on the free gradient there.
+                move(p, along.to_bound, false);
+                over_chunks<SplitSums>(n, threads, [&](Index first, Index last) {
+                  for (Index j = first; j < last; ++j)
+                    if (y[j] > 0)
+                      y[j] = std::max(0.0, y[j] - alpha * g[j]);
+                  return SplitSums{};
+                });
+                split = gradient_and_split();
               }
           }
         else
           {
             // Proportioning step along the chopped gradient, exact line search.
-            product(beta, Ap);
-            const double step = beta2 / beta.dot(Ap);
-            y -= step * beta;
-            g -= step * Ap;
-            worst = split();
+            const ProductSums along = product(beta);
+            split = move(beta, split.beta2 / along.pAp, false);
             p     = phi;
           }
       }
-    // Round-off may leave y_i a little below 0 after a CG step that reached a bound:
-    // apply() projects.
-    const Eigen::VectorXd x = y.cwiseProduct(inv_root);
-    lcp.apply(x, contacts, state);
+    // A CG step that reached a bound may leave y_j a round-off below 0: apply() projects.
+    lcp.apply(y.cwiseProduct(inv_root), contacts, state);
     return report;
   }
 } // namespace tribo::dem

@@ -56,7 +56,7 @@ namespace tribo::dem
     unsigned int max_factorizations = 50;
     /// Active set and MPRGP: the solve ends when the natural map max |min(x, w / W_nn)|
     /// (dem/frictionless_problem.h) is below this times the warm start's mean loaded
-    /// impulse x_mean (the active set also stops below 1000 times that when an iteration
+    /// impulse x_mean (the active set also stops below 1e-8 x_mean when an iteration
     /// no longer halves it: round-off).
     double residual_target = 1e-11;
     enum class Norm
