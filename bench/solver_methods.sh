@@ -4,7 +4,8 @@
 # no start-up), the solver's share, iterations per step (NLGS sweeps, predictor sweeps
 # plus MPRGP products), CHOLMOD factorisations per step, the law residual reached (mean
 # and max over the steps, docs/laws.md), the worst overlap over the smallest radius, and
-# mean mu. Run it on an otherwise idle machine; settings are timed in turn, in one sitting.
+# mean mu +/- its batch-means standard error (10 contiguous batches, the estimator of
+# scripts/study_stderr.py; meaningful over several hundred steps). Run it on an otherwise idle machine; settings are timed in turn, in one sitting.
 #
 #   bash bench/solver_methods.sh RUN_DIR STEPS "SETTING" ["SETTING" ...]
 #
@@ -20,8 +21,11 @@ tribo=${TRIBO:-$here/build/bin/tribo}
 exec /usr/bin/python3 - "$tribo" "$@" <<'PY'
 import csv, json, os, re, shutil, subprocess, sys, tempfile
 
+import numpy as np
+
 tribo, src, steps, settings = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
-fixed = ["Output/Field interval=0", "Output/Plots=false", "Output/Statistics interval=1",
+# One core and the plain sweep unless a setting says otherwise (later --set entries win).
+fixed = ["Solver/Threads=1", "Solver/Streams=1", "Output/Field interval=0", "Output/Plots=false", "Output/Statistics interval=1",
          "Output/Checkpoint interval=0", "Output/Checkpoint step interval=0"]
 
 
@@ -52,7 +56,7 @@ try:
     step0, _ = resume(1e-12, dst, [])  # logs the checkpoint's step, runs nothing
     print(f"checkpoint {src} at step {step0}, {steps} steps per setting")
     print("| setting | ms per step | solver ms | iterations per step | factorisations per step "
-          "| law residual mean / max | worst overlap / r_min | mean mu |")
+          "| law residual mean / max | worst overlap / r_min | mu |")
     print("|---|---|---|---|---|---|---|---|")
     for setting in settings:
         extra = [s.strip() for s in re.split(r"\s+(?=[A-Z][A-Za-z ]*/)", setting.strip()) if s.strip()]
@@ -62,11 +66,13 @@ try:
         t = s["timing"]
         lr = [float(r["law_residual"]) for r in rows]
         overlap = max(float(r["max_overlap"]) for r in rows)
-        mu = sum(float(r["mu"]) for r in rows) / len(rows)
+        mu = np.array([float(r["mu"]) for r in rows])
+        batches = np.array([b.mean() for b in np.array_split(mu, 10)])
+        mu_stderr = batches.std(ddof=1) / np.sqrt(len(batches))
         print(f"| {setting} | {t['step_mean_s'] * 1e3:.1f} | {t['nlgs_mean_s'] * 1e3:.1f} "
               f"| {t['nlgs_sweeps_mean']:.1f} | {s.get('factorizations_mean', 0):.1f} "
               f"| {sum(lr) / len(lr):.2e} / {max(lr):.2e} "
-              f"| {overlap / r_min if r_min else float('nan'):.2f} | {mu:.4f} |", flush=True)
+              f"| {overlap / r_min if r_min else float('nan'):.2f} | {mu.mean():.4f} +/- {mu_stderr:.4f} |", flush=True)
 finally:
     shutil.rmtree(tmp)
 PY

@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Contact solvers against sample size: the established code's benchmark cell
+# (cases/shear/reference_bench.prm) scaled to N grains, either at fixed layer thickness
+# (period and wall discs in proportion to N: `width`) or at fixed period (the layer
+# N / 3800 times as thick: `thickness`). Each sample is compacted for 1e-5 s (1000 steps,
+# MPRGP to a law residual of 1e-2 on both cores, the cheapest way to a dense packing),
+# sheared for SHEAR steps (default 500) to a checkpoint, then each SETTING resumes it for
+# STEPS steps (default 50) through bench/solver_methods.sh, which prints the table.
+#
+#   bash bench/solver_scaling.sh width|thickness N [N ...] -- SETTING [SETTING ...]
+#
+# e.g. bash bench/solver_scaling.sh width 1000 4000 16000 -- "Solver/Method=nlgs" \
+#          "Solver/Method=mprgp Solver/Residual target=1.5e-3"
+# Samples are kept in ${SCALING_DIR:-/tmp/tribo-solver-scaling}/<mode>-<N>; an existing
+# checkpoint is reused. Run it on an otherwise idle machine.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+tribo=${TRIBO:-$here/build/bin/tribo}
+mode=${1:-}; shift || true
+[ "$mode" = width ] || [ "$mode" = thickness ] || { echo "usage: $0 width|thickness N [N ...] -- SETTING [SETTING ...]" >&2; exit 2; }
+sizes=()
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do sizes+=("$1"); shift; done
+[ $# -gt 1 ] || { echo "$0: no SETTING after --" >&2; exit 2; }
+shift
+shear=${SHEAR:-500}
+steps=${STEPS:-50}
+root=${SCALING_DIR:-/tmp/tribo-solver-scaling}
+mkdir -p "$root"
+for n in "${sizes[@]}"; do
+  if [ "$mode" = width ]; then
+    length=$(/usr/bin/python3 -c "print(1e-4 * $n / 3800)")
+    walls=$(/usr/bin/python3 -c "print(max(8, round(100 * $n / 3800)))")
+  else
+    length=1e-4
+    walls=100
+  fi
+  dir="$root/$mode-$n"
+  if [ ! -f "$dir/checkpoint.bin" ]; then
+    rm -rf "$dir"
+    end=$(/usr/bin/python3 -c "print((1000 + $shear) * 1e-8 + 5e-8)")
+    "$tribo" run "$here/cases/shear/reference_bench.prm" --output "$dir" --quiet \
+      --set "Shear cell/Number of discs=$n" --set "Shear cell/Length=$length" \
+      --set "Shear cell/Wall discs=$walls" --set "Shear cell/Shear start=1e-5" \
+      --set "Simulation/End time=$end" --set "Solver/Method=mprgp" \
+      --set "Solver/Residual target=1e-2" --set "Solver/Threads=2" \
+      --set "Output/Checkpoint step interval=$((1000 + shear))" --set "Output/Plots=false" &
+    pid=$!
+    while [ ! -f "$dir/checkpoint.bin" ] && kill -0 "$pid" 2>/dev/null; do sleep 1; done
+    kill -TERM "$pid" 2>/dev/null || true
+    wait "$pid" || true
+    [ -f "$dir/checkpoint.bin" ] || { echo "$0: $dir: no checkpoint (see its log.txt)" >&2; exit 1; }
+  fi
+  echo "## $mode, $n grains (period $length m, $walls wall discs)"
+  bash "$here/bench/solver_methods.sh" "$dir" "$steps" "$@"
+done
