@@ -575,9 +575,11 @@ namespace tribo::app
        << non_converged << " steps not converged, law residual mean "
        << (step ? sum_law_residual / step : 0.0) << " max " << max_law_residual
        << ", worst overlap " << worst_overlap << " m";
+    if (p.solver.method == dem::SolverParameters::Method::active_set ||
+        p.solver.method == dem::SolverParameters::Method::interior_point)
+      os << ", " << (step ? double(total_factorizations) / step : 0.0) << " factorisations per step";
     if (p.solver.method == dem::SolverParameters::Method::active_set)
-      os << ", " << (step ? double(total_factorizations) / step : 0.0)
-         << " factorisations per step, " << fallbacks << " NLGS fallbacks";
+      os << ", " << fallbacks << " NLGS fallbacks";
     if (timing.steps > 0)
       {
         const double n = timing.steps;

@@ -31,7 +31,6 @@ namespace tribo::dem
     const Eigen::VectorXd             &b = lcp.b;
     Eigen::VectorXd       x = lcp.x;
     const double          scale     = lcp.scale;
-    const double          tolerance = prm.residual_target * scale;
 
     // Projected Newton iterations (Bertsekas 1982) on f(x) = x.A x / 2 + b.x, x >= 0,
     // whose minimum is the LCP's solution; w = A x + b is f's gradient.
@@ -45,7 +44,7 @@ namespace tribo::dem
     for (;;)
       {
         const double worst = lcp.natural_map(x, w);
-        if (worst <= tolerance)
+        if (worst <= prm.residual_target * lcp.mean_loaded(x))
           break;
         // Round-off floor: below 1e-8 of the mean impulse, an iteration that does not
         // halve the natural map ends the solve (the energy no longer tells the iterates

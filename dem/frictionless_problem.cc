@@ -44,6 +44,19 @@ namespace tribo::dem
                     : 1.0;
   }
 
+  double FrictionlessProblem::mean_loaded(const Eigen::VectorXd &y) const
+  {
+    double       sum    = 0;
+    unsigned int loaded = 0;
+    for (Eigen::Index i = 0; i < y.size(); ++i)
+      if (y[i] > 0)
+        {
+          sum += y[i];
+          ++loaded;
+        }
+    return loaded ? sum / loaded : scale;
+  }
+
   double FrictionlessProblem::natural_map(const Eigen::VectorXd &y, const Eigen::VectorXd &w) const
   {
     double worst = 0;

@@ -40,6 +40,9 @@ namespace tribo::dem
     double scale = 0;
 
     Eigen::Index size() const { return b.size(); }
+    /// The mean of the positive entries of @p y (N s/m), or scale without one: the
+    /// denominator of the law residual (dem/law_residual.h).
+    double mean_loaded(const Eigen::VectorXd &y) const;
     /// max_i |min(y_i, w_i / A_ii)| with w = A y + b given, N s/m.
     double natural_map(const Eigen::VectorXd &y, const Eigen::VectorXd &w) const;
     /// f(y) = y.A y / 2 + b.y with w = A y + b given.

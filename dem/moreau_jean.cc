@@ -21,6 +21,7 @@ namespace tribo::dem
     , solver(solver)
     , active_set(solver)
     , mprgp(solver)
+    , interior_point(solver)
     , predictor([&] {
       SolverParameters p = solver;
       p.max_iterations   = std::max(1U, solver.predictor_sweeps);
@@ -61,9 +62,12 @@ namespace tribo::dem
     unsigned int            sweeps   = 0;
     if (controls.predictor_sweeps > 0)
       sweeps = predictor.solve(current, state, contact_law, th * h).iterations;
-    if (controls.method == SolverParameters::Method::mprgp)
+    if (controls.method == SolverParameters::Method::mprgp ||
+        controls.method == SolverParameters::Method::interior_point)
       {
-        SolveReport report = mprgp.solve(current, state, contact_law);
+        SolveReport report = controls.method == SolverParameters::Method::mprgp
+                               ? mprgp.solve(current, state, contact_law)
+                               : interior_point.solve(current, state, contact_law);
         report.iterations += sweeps;
         return report;
       }
@@ -304,8 +308,10 @@ namespace tribo::dem
         const double speed = std::max(fastest.first, fastest_node);
         std::ostringstream os;
         os << "an overlap of " << deepest_overlap << " m, more than the smallest disc radius ("
-           << r_min << " m): contacts were missed or left unresolved (NLGS "
-           << (report.solver.converged ? "converged" : "not converged") << "). ";
+           << r_min << " m): contacts were missed or left unresolved ("
+           << method_name(global_method() && !report.solver.fell_back ? solver.parameters().method
+                                                                      : SolverParameters::Method::nlgs)
+           << " " << (report.solver.converged ? "converged" : "not converged") << "). ";
         if (speed * h > 0.25 * r_min)
           os << "The fastest mover, "
              << (fastest.first >= fastest_node ? "body " + std::to_string(fastest.second)

@@ -13,6 +13,7 @@
 #include "dem/boundary.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
+#include "dem/interior_point.h"
 #include "dem/mprgp.h"
 #include "dem/nlgs.h"
 #include "dem/particle_system.h"
@@ -132,6 +133,7 @@ namespace tribo::dem
     NlgsSolver               solver;
     ActiveSetSolver          active_set;
     MprgpSolver              mprgp;
+    InteriorPointSolver      interior_point;
     NlgsSolver               predictor; ///< the active set's predictor sweeps
     double                   distance;
     ContactDetector          detector;

@@ -53,12 +53,19 @@ namespace tribo::dem
     };
 
     /// Reductions of a split pass (file comment of mprgp.h): the natural map, ||beta||^2,
-    /// phi~.phi and phi.A'p.
+    /// phi~.phi and phi.A'p, and the sum and count of the loaded impulses x_j > 0.
     struct SplitSums
     {
-      double worst = 0, beta2 = 0, proportional = 0, phi_Ap = 0;
-      void   merge(const SplitSums &o)
+      double worst = 0, beta2 = 0, proportional = 0, phi_Ap = 0, loaded_sum = 0, loaded = 0;
+      /// The natural map over the mean loaded impulse (over @p fallback without one).
+      double relative(double fallback) const
       {
+        return worst / (loaded > 0 ? loaded_sum / loaded : fallback);
+      }
+      void merge(const SplitSums &o)
+      {
+        loaded_sum += o.loaded_sum;
+        loaded += o.loaded;
         worst = std::max(worst, o.worst);
         beta2 += o.beta2;
         proportional += o.proportional;
@@ -99,7 +106,6 @@ namespace tribo::dem
       }
     const Eigen::VectorXd b         = lcp.b.cwiseProduct(inv_root);
     const double          alpha     = 1.9 / norm_bound;
-    const double          tolerance = prm.residual_target * lcp.scale;
     const double          gamma2    = 1.0; // Gamma^2
     const unsigned int    threads   = prm.threads;
 
@@ -125,6 +131,8 @@ namespace tribo::dem
           s.proportional += std::min(y[j] / alpha, g[j]) * g[j];
           if (with_Ap)
             s.phi_Ap += phi[j] * Ap[j];
+          s.loaded_sum += y[j] * inv_root[j];
+          s.loaded += 1;
         }
       else
         {
@@ -185,7 +193,7 @@ namespace tribo::dem
     };
 
     SplitSums split = gradient_and_split();
-    while (split.worst > tolerance)
+    while (split.relative(lcp.scale) > prm.residual_target)
       {
         if (report.iterations >= prm.max_iterations)
           {

@@ -24,8 +24,8 @@
 /// algorithms", ch. 9, which proves R-linear convergence for A positive definite).
 ///
 /// It stops when the natural map max_i |min(x_i, w_i / A_ii)| = max_i |min(y_i, g_i)| /
-/// sqrt(D_i) is at most SolverParameters::residual_target times the warm start's mean
-/// loaded impulse, or after SolverParameters::max_iterations products with A' (each
+/// sqrt(D_i) is at most SolverParameters::residual_target times the iterate's mean loaded
+/// impulse (the law residual's measure, dem/law_residual.h), or after SolverParameters::max_iterations products with A' (each
 /// about the cost of one NLGS sweep); it then keeps its last iterate, which satisfies
 /// x >= 0, and reports not converged.
 

@@ -274,7 +274,7 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   MoreauJean     mj(0.5, ContactLaw{}, tight(), 1e-8);
   EXPECT_EQ(step_error(mj, placed, 1e-8),
             "an overlap of 7e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
-            "missed or left unresolved (NLGS converged). No body moved more than a quarter of "
+            "missed or left unresolved (nlgs converged). No body moved more than a quarter of "
             "the smallest radius in the step: the overlap does not come from the step size. "
             "Either discs were placed overlapping, or the law lets it grow: with IQS, overlaps "
             "kept step after step within the solver's tolerance (high pressure: tighten "
@@ -287,7 +287,7 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   MoreauJean     mj2(0.5, ContactLaw{}, tight(), 1e-6);
   EXPECT_EQ(step_error(mj2, fast, 1e-8),
             "an overlap of 9e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
-            "missed or left unresolved (NLGS converged). The fastest mover, body 1, moved 1e-06 m "
+            "missed or left unresolved (nlgs converged). The fastest mover, body 1, moved 1e-06 m "
             "in the step (100 m/s); a step of at most 1.5e-09 s keeps it within a quarter of the "
             "smallest radius");
   // At 20 m/s the same pair ends each step with an overlap of at most (1 - theta) h v.

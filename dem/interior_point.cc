@@ -1,0 +1,137 @@
+#include "dem/interior_point.h"
+
+#include "core/errors.h"
+#include "dem/frictionless_problem.h"
+
+#include <Eigen/CholmodSupport>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tribo::dem
+{
+  namespace
+  {
+    /// The largest alpha in (0, 1] with v + alpha dv >= 0, times @p fraction when limited.
+    double step_to_boundary(const Eigen::VectorXd &v, const Eigen::VectorXd &dv, double fraction)
+    {
+      double alpha = 1;
+      for (Eigen::Index i = 0; i < v.size(); ++i)
+        if (dv[i] < 0)
+          alpha = std::min(alpha, -fraction * v[i] / dv[i]);
+      return alpha;
+    }
+  } // namespace
+
+  InteriorPointSolver::InteriorPointSolver(const SolverParameters &p)
+    : prm(p)
+  {}
+
+  SolveReport InteriorPointSolver::solve(std::vector<Contact> &contacts, BodyState &state,
+                                         const ContactLaw &law)
+  {
+    SolveReport report;
+    if (contacts.empty())
+      return report;
+    if (law.friction > 0)
+      throw RunError("the interior-point method solves frictionless problems only (Coulomb "
+                     "friction mu = " + std::to_string(law.friction) + ")");
+
+    const FrictionlessProblem lcp(contacts, state);
+    const Eigen::Index        n = lcp.size();
+    // The scaled problem: A' = S A S, b' = S b, y = x / s, S = D^(-1/2).
+    const Eigen::VectorXd       inv_root = lcp.diagonal.cwiseSqrt().cwiseInverse();
+    Eigen::SparseMatrix<double> A        = lcp.A;
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::SparseMatrix<double>::InnerIterator a(A, j); a; ++a)
+        a.valueRef() *= inv_root[a.row()] * inv_root[j];
+    const Eigen::VectorXd b         = lcp.b.cwiseProduct(inv_root);
+
+    Eigen::VectorXd y = lcp.x.cwiseQuotient(inv_root);
+    double          warm_sum = 0;
+    unsigned int    loaded      = 0;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (y[i] > 0)
+        {
+          warm_sum += y[i];
+          ++loaded;
+        }
+    const double nu = 1e-2 * (loaded ? warm_sum / loaded : (b.cwiseAbs().mean() + 1e-300));
+    y               = y.cwiseMax(nu);
+    Eigen::VectorXd g = A * y + b, s = g.cwiseMax(nu);
+
+    // The natural map in x units: max |min(y_i, g_i)| / sqrt(D_i), y projected on y >= 0.
+    auto natural_map = [&]() {
+      double worst = 0;
+      for (Eigen::Index i = 0; i < n; ++i)
+        worst = std::max(worst, std::abs(std::min(y[i], g[i])) * inv_root[i]);
+      return worst;
+    };
+
+    Eigen::SparseMatrix<double> K = A;
+    Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+    cholesky.analyzePattern(K);
+    std::vector<double *> diagonal(n);
+    Eigen::VectorXd       unit(n); // the diagonal of A' (1 up to round-off)
+    for (Eigen::Index j = 0; j < n; ++j)
+      {
+        diagonal[j] = &K.coeffRef(j, j);
+        unit[j]     = *diagonal[j];
+      }
+    Eigen::VectorXd r(n), rhs(n), dy(n), ds(n), dy_a(n), ds_a(n);
+    // Round-off floor: below 1e-6 of the mean impulse, two iterations in a row that do not
+    // halve the natural map end the solve (K's condition grows like 1 / mu).
+    double       worst = natural_map(), last_worst = std::numeric_limits<double>::infinity();
+    unsigned int stalled = 0;
+    // The iterate's mean loaded impulse: y is interior, so the contacts whose impulse
+    // exceeds their velocity (y_i > g_i in the scaled units; the others head for zero).
+    auto mean_loaded = [&]() {
+      double sum = 0, count = 0;
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (y[i] > g[i])
+          {
+            sum += y[i] * inv_root[i];
+            ++count;
+          }
+      return count > 0 ? sum / count : lcp.scale;
+    };
+    while (worst > prm.residual_target * mean_loaded())
+      {
+        stalled    = worst <= 1e-6 * lcp.scale && worst > 0.5 * last_worst ? stalled + 1 : 0;
+        last_worst = worst;
+        if (report.factorizations >= prm.max_factorizations || stalled >= 2)
+          {
+            report.converged = false;
+            break;
+          }
+        r               = g - s;
+        const double mu = y.dot(s) / n;
+        for (Eigen::Index j = 0; j < n; ++j)
+          *diagonal[j] = unit[j] + s[j] / y[j];
+        cholesky.factorize(K);
+        ++report.factorizations;
+        if (cholesky.info() != Eigen::Success)
+          throw RunError("the interior-point method could not factorise A' + Y^-1 S");
+        // Predictor (affine scaling).
+        rhs  = -r - s;
+        dy_a = cholesky.solve(rhs);
+        ds_a = A * dy_a + r;
+        const double alpha_a = std::min(step_to_boundary(y, dy_a, 1.0), step_to_boundary(s, ds_a, 1.0));
+        const double mu_a    = (y + alpha_a * dy_a).dot(s + alpha_a * ds_a) / n;
+        const double sigma   = std::pow(std::max(0.0, mu_a) / mu, 3);
+        // Corrector.
+        for (Eigen::Index j = 0; j < n; ++j)
+          rhs[j] = -r[j] - s[j] + (sigma * mu - dy_a[j] * ds_a[j]) / y[j];
+        dy = cholesky.solve(rhs);
+        ds = A * dy + r;
+        const double alpha = std::min(step_to_boundary(y, dy, 0.995), step_to_boundary(s, ds, 0.995));
+        y += alpha * dy;
+        s += alpha * ds;
+        g     = A * y + b;
+        worst = natural_map();
+      }
+    lcp.apply(y.cwiseProduct(inv_root), contacts, state);
+    return report;
+  }
+} // namespace tribo::dem

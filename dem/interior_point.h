@@ -1,0 +1,44 @@
+#pragma once
+/// @file A primal-dual interior-point method (Mehrotra's predictor-corrector) for the
+/// frictionless contact problem (dem/frictionless_problem.h), on the sparse Delassus
+/// operator factorised by CHOLMOD.
+///
+/// In the diagonally scaled variables of dem/mprgp.h (y = D^(1/2) x, A' = D^(-1/2) A
+/// D^(-1/2), b' = D^(-1/2) b), the problem 0 <= y _|_ s = A'y + b' >= 0 is followed along
+/// its central path y_i s_i = mu > 0, mu -> 0. With the residual r = A'y + b' - s, each
+/// iteration solves twice with one factorisation of
+///     K = A' + Y^-1 S        (symmetric positive definite for y, s > 0, whatever the
+///                             redundancy of the contacts: no regularisation needed)
+/// - predictor: K dy = -r - s, ds = A' dy + r; the largest step alpha_a that keeps y, s >= 0
+///   gives mu_a = (y + alpha_a dy).(s + alpha_a ds) / n and the centring sigma = (mu_a / mu)^3;
+/// - corrector: K dy = -r - s + (sigma mu - dy_a ds_a) / y, ds = A' dy + r;
+/// - step: 0.995 of the largest step that keeps y, s > 0, the same for both.
+/// Start: y_0 = max(warm start, nu), s_0 = max(A'y_0 + b', nu), nu a hundredth of the mean
+/// warm-started impulse (scaled). It stops at the natural-map test of the other global
+/// methods (SolverParameters::residual_target, the solution being y projected onto y >= 0)
+/// or after SolverParameters::max_factorizations, or when, below 1e-6 of the mean impulse,
+/// two iterations in a row do not halve the natural map (round-off: K's condition grows
+/// like 1 / mu), keeping its iterate (reported not converged). Cost per iteration: one numeric factorisation (the symbolic analysis once
+/// per step), two solves, two products with A'.
+
+#include "dem/contact.h"
+#include "dem/contact_law.h"
+#include "dem/nlgs.h"
+
+#include <vector>
+
+namespace tribo::dem
+{
+  class InteriorPointSolver
+  {
+  public:
+    explicit InteriorPointSolver(const SolverParameters &p = {});
+    /// Solve the frictionless problem of @p contacts (warm-started from their r, whose
+    /// effect must already be in @p state), updating their impulses and @p state.
+    /// Throws RunError if @p law has friction. The report counts factorizations.
+    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law);
+
+  private:
+    SolverParameters prm;
+  };
+} // namespace tribo::dem
