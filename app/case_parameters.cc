@@ -65,10 +65,12 @@ namespace tribo::app
                       "'active-set' (projected Newton method on the frictionless problem, the "
                       "sparse Delassus operator factorised by CHOLMOD) or 'mprgp' (matrix-free "
                       "projected conjugate gradient with proportioning, on both cores with "
-                      "Threads = 2). The last two stop at Residual target; with friction their "
-                      "steps use NLGS and the log says so. docs/performance.md compares them.");
+                      "Threads = 2) or 'interior-point' (Mehrotra's predictor-corrector, CHOLMOD: "
+                      "the one that reaches 1e-8 on dense packings). The last three stop at "
+                      "Residual target; with friction their steps use NLGS and the log says so. "
+                      "docs/performance.md compares them.");
     prm.declare_entry("Residual target", "1.5e-3", Double(),
-                      "Active set and MPRGP: the solve ends when the law residual, max over "
+                      "Active set, MPRGP, interior point: the solve ends when the law residual, max over "
                       "contacts of |min(r~, u~ / W_nn)| over the mean loaded impulse r~ "
                       "(dimensionless, docs/laws.md), is below this, in (0, 1). The default is "
                       "what NLGS reaches on average at its default Tolerance (1e-4, Quad) in "
@@ -78,10 +80,12 @@ namespace tribo::app
                       "W_FF + delta diag(W_FF) (redundant contacts make W_FF singular); it changes "
                       "the Newton step, not the solution.");
     prm.declare_entry("Predictor sweeps", "10", Integer(0),
-                      "Active set and MPRGP: NLGS sweeps before their iterations, >= 0.");
+                      "Active set, MPRGP, interior point: NLGS sweeps before their iterations, >= 0 "
+                      "(0 suits the interior point).");
     prm.declare_entry("Maximum factorizations", "50", Integer(1),
                       "Active set: Newton iterations (factorisations) per step before the step is "
-                      "solved by NLGS instead, >= 1.");
+                      "solved by NLGS instead; interior point: iterations before it stops, not "
+                      "converged, >= 1.");
     prm.declare_entry("Tolerance", "1e-4", Double(), "NLGS tolerance, > 0 (relative, see Norm).");
     prm.declare_entry("Norm", "Quad", Selection("Quad|Maxm"),
                       "Convergence norm of the established NSCD code: 'Quad' (mean-square) or "

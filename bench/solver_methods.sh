@@ -35,7 +35,7 @@ def resume(end, dst, extra):
     args = [tribo, "run", os.path.join(dst, "parameters.prm"), "--resume", dst, "--quiet"]
     for s in fixed + ["Simulation/End time=%.17g" % end] + extra:
         args += ["--set", s]
-    subprocess.run(args, check=True, capture_output=True)
+    subprocess.run(args, capture_output=True)  # a failed run is reported, not fatal
     step0 = int(re.findall(r"resumed at step (\d+)", open(os.path.join(dst, "log.txt")).read())[-1])
     return step0, json.load(open(os.path.join(dst, "summary.json")))
 
@@ -63,14 +63,20 @@ try:
         _, s = resume((step0 + steps) * h, dst, extra)
         rows = [r for r in csv.DictReader(open(os.path.join(dst, "statistics.csv")))
                 if int(float(r["step"])) > step0]
+        if s["status"] != "complete":
+            print(f"| {setting} | {s['status']} after {len(rows)} steps: {s.get('error', '')[:160]} |",
+                  flush=True)
+            continue
         t = s["timing"]
+        # summary.json's mean is over every step of the run, the checkpoint's (NLGS) included.
+        factorizations = s.get("factorizations_mean", 0) * s["steps"] / len(rows)
         lr = [float(r["law_residual"]) for r in rows]
         overlap = max(float(r["max_overlap"]) for r in rows)
         mu = np.array([float(r["mu"]) for r in rows])
         batches = np.array([b.mean() for b in np.array_split(mu, 10)])
         mu_stderr = batches.std(ddof=1) / np.sqrt(len(batches))
         print(f"| {setting} | {t['step_mean_s'] * 1e3:.1f} | {t['nlgs_mean_s'] * 1e3:.1f} "
-              f"| {t['nlgs_sweeps_mean']:.1f} | {s.get('factorizations_mean', 0):.1f} "
+              f"| {t['nlgs_sweeps_mean']:.1f} | {factorizations:.1f} "
               f"| {sum(lr) / len(lr):.2e} / {max(lr):.2e} "
               f"| {overlap / r_min if r_min else float('nan'):.2f} | {mu.mean():.4f} +/- {mu_stderr:.4f} |", flush=True)
 finally:

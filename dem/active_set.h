@@ -17,8 +17,8 @@
 /// - Armijo search on f along x(alpha) = max(0, x + alpha d) (the full step is also taken
 ///   when it halves the natural map: near the solution f's round-off hides the decrease);
 /// - stop when max_i |min(x_i, w_i / D_i)| <= tau x_mean (tau =
-///   SolverParameters::residual_target, x_mean the warm start's mean loaded
-///   impulse), or <= 1e-8 x_mean once an iteration no longer halves it (round-off).
+///   SolverParameters::residual_target, x_mean the iterate's mean loaded impulse), or
+///   <= 1e-8 of the warm start's once an iteration no longer halves it (round-off).
 /// Cost per step: one assembly, one CHOLMOD symbolic analysis on the pattern of all
 /// detected contacts (the binding ones are decoupled in the values, so the pattern holds
 /// within the step), one numeric factorisation per iteration, sparse products in the

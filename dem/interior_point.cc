@@ -71,6 +71,7 @@ namespace tribo::dem
 
     Eigen::SparseMatrix<double> K = A;
     Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+    cholesky.cholmod().print = 0; // a failed factorisation is handled below, not printed
     cholesky.analyzePattern(K);
     std::vector<double *> diagonal(n);
     Eigen::VectorXd       unit(n); // the diagonal of A' (1 up to round-off)
@@ -107,12 +108,24 @@ namespace tribo::dem
           }
         r               = g - s;
         const double mu = y.dot(s) / n;
-        for (Eigen::Index j = 0; j < n; ++j)
-          *diagonal[j] = unit[j] + s[j] / y[j];
-        cholesky.factorize(K);
-        ++report.factorizations;
-        if (cholesky.info() != Eigen::Success)
-          throw RunError("the interior-point method could not factorise A' + Y^-1 S");
+        // K is positive definite, but with A' singular (redundant contacts) and s_i / y_i
+        // spanning many decades near the solution it can fail numerically: then the
+        // Newton step of K + 1e-10 I, and if that fails too, the solve stops here.
+        bool factorised = false;
+        for (const double shift : {0.0, 1e-10})
+          {
+            for (Eigen::Index j = 0; j < n; ++j)
+              *diagonal[j] = unit[j] + s[j] / y[j] + shift;
+            cholesky.factorize(K);
+            ++report.factorizations;
+            if ((factorised = cholesky.info() == Eigen::Success))
+              break;
+          }
+        if (!factorised)
+          {
+            report.converged = false;
+            break;
+          }
         // Predictor (affine scaling).
         rhs  = -r - s;
         dy_a = cholesky.solve(rhs);

@@ -16,7 +16,9 @@
 /// Start: y_0 = max(warm start, nu), s_0 = max(A'y_0 + b', nu), nu a hundredth of the mean
 /// warm-started impulse (scaled). It stops at the natural-map test of the other global
 /// methods (SolverParameters::residual_target, the solution being y projected onto y >= 0)
-/// or after SolverParameters::max_factorizations, or when, below 1e-6 of the mean impulse,
+/// or after SolverParameters::max_factorizations, or when K cannot be factorised even with
+/// 1e-10 I added (a numerically singular K near the solution), or when, below 1e-6 of the
+/// mean impulse,
 /// two iterations in a row do not halve the natural map (round-off: K's condition grows
 /// like 1 / mu), keeping its iterate (reported not converged). Cost per iteration: one numeric factorisation (the symbolic analysis once
 /// per step), two solves, two products with A'.

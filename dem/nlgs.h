@@ -52,15 +52,16 @@ namespace tribo::dem
     /// diag(W_FF) (redundant, hyperstatic contacts make W_FF singular; it changes the step,
     /// not the solution).
     double regularization = 1e-8;
-    /// Active set and MPRGP: NLGS sweeps before their iterations (0: none).
+    /// Global methods: NLGS sweeps before their iterations (0: none).
     unsigned int predictor_sweeps = 10;
-    /// Active set: factorisations per step before the step is solved by NLGS instead.
+    /// Active set: factorisations per step before the step is solved by NLGS instead;
+    /// interior point: iterations per step before it stops, not converged.
     unsigned int max_factorizations = 50;
-    /// Active set and MPRGP: the solve ends when the natural map max |min(x, w / W_nn)|
-    /// (dem/frictionless_problem.h) is below this times the warm start's mean loaded
-    /// impulse x_mean (the active set also stops below 1e-8 x_mean when an iteration
-    /// no longer halves it: round-off). The default, 1.5e-3, is what NLGS reaches on
-    /// average at Quad 1e-4 in steady shear (docs/performance.md).
+    /// Global methods: the solve ends when the natural map max |min(x, w / W_nn)|
+    /// (dem/frictionless_problem.h) is below this times the iterate's mean loaded impulse
+    /// (the law residual, dem/law_residual.h; the active set and the interior-point method
+    /// also stop at their round-off floors). The default, 1.5e-3, is what NLGS reaches
+    /// on average at Quad 1e-4 in steady shear (docs/performance.md).
     double residual_target = 1.5e-3;
     enum class Norm
     {
