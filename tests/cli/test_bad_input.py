@@ -228,6 +228,15 @@ class MeaninglessValues(BadInputTestCase):
     def test_zero_relaxation(self):
         self.check_entry("Solver/Relaxation", "0", "a relaxation in (0, 1]")
 
+    def test_residual_target_out_of_range(self):
+        self.check_entry("Solver/Residual target", "0", "a relative residual in (0, 1)")
+        self.check_entry("Solver/Residual target", "2", "a relative residual in (0, 1)")
+
+    def test_unknown_solver_method(self):
+        msg, where = self.run_bad_case(case({"Solver/Method": "cg"}))
+        self.assert_at_line(msg, where["Solver/Method"])
+        self.assert_parts(msg, "Method", "cg", "nlgs|active-set|mprgp|interior-point")
+
     def test_bands_need_the_fixed_order(self):
         sections = case({"Solver/Threads": "2", "Solver/Contact order": "random"})
         self.check_entry("Solver/Threads", "2",
