@@ -22,9 +22,7 @@ namespace tribo::dem
     const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());
     if (n == 0)
       return report;
-    if (law.friction > 0)
-      throw RunError("the active-set method solves frictionless problems only (Coulomb friction "
-                     "mu = " + std::to_string(law.friction) + ")");
+    require_frictionless(law, "active-set");
 
     FrictionlessProblem   lcp(contacts, state);
     const Eigen::SparseMatrix<double> &A = lcp.A;

@@ -1,5 +1,6 @@
 #include "dem/frictionless_problem.h"
 
+#include "core/errors.h"
 #include "dem/delassus.h"
 #include "dem/nlgs.h"
 
@@ -63,6 +64,26 @@ namespace tribo::dem
     for (Eigen::Index i = 0; i < y.size(); ++i)
       worst = std::max(worst, std::abs(std::min(y[i], w[i] / diagonal[i])));
     return worst;
+  }
+
+  FrictionlessProblem::Scaled FrictionlessProblem::scaled() const
+  {
+    Scaled p;
+    p.inv_root = diagonal.cwiseSqrt().cwiseInverse();
+    p.A        = A;
+    for (Eigen::Index j = 0; j < p.A.cols(); ++j)
+      for (Eigen::SparseMatrix<double>::InnerIterator a(p.A, j); a; ++a)
+        a.valueRef() *= p.inv_root[a.row()] * p.inv_root[j];
+    p.b = b.cwiseProduct(p.inv_root);
+    p.y = x.cwiseQuotient(p.inv_root);
+    return p;
+  }
+
+  void require_frictionless(const ContactLaw &law, const std::string &method)
+  {
+    if (law.friction > 0)
+      throw RunError("the " + method + " method solves frictionless problems only (Coulomb "
+                     "friction mu = " + std::to_string(law.friction) + ")");
   }
 
   void FrictionlessProblem::apply(const Eigen::VectorXd &y, std::vector<Contact> &contacts,

@@ -14,10 +14,12 @@
 /// is zero exactly at a solution; it is the law residual's phi_n (dem/law_residual.h).
 
 #include "dem/contact.h"
+#include "dem/contact_law.h"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <string>
 #include <vector>
 
 namespace tribo::dem
@@ -50,9 +52,23 @@ namespace tribo::dem
     {
       return 0.5 * y.dot(w + b);
     }
+    /// The problem in the variables y = D^(1/2) x (D = diag A): A' = D^(-1/2) A D^(-1/2)
+    /// (unit diagonal), b' = D^(-1/2) b, the same bounds y >= 0; g = A'y + b' = D^(-1/2) w.
+    struct Scaled
+    {
+      Eigen::VectorXd             inv_root; ///< D^(-1/2), x = inv_root y
+      Eigen::SparseMatrix<double> A;
+      Eigen::VectorXd             b;
+      Eigen::VectorXd             y; ///< the warm start
+    };
+    Scaled scaled() const;
+
     /// Write the impulses r_n = max(0, y) - gamma h into @p contacts (r_t = 0) and apply
     /// the change to @p state's velocities.
     void apply(const Eigen::VectorXd &y, std::vector<Contact> &contacts, BodyState &state) const;
   };
 
+
+  /// Throws RunError naming @p method unless @p law is frictionless.
+  void require_frictionless(const ContactLaw &law, const std::string &method);
 } // namespace tribo::dem

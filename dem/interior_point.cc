@@ -1,6 +1,5 @@
 #include "dem/interior_point.h"
 
-#include "core/errors.h"
 #include "dem/frictionless_problem.h"
 
 #include <Eigen/CholmodSupport>
@@ -34,30 +33,16 @@ namespace tribo::dem
     SolveReport report;
     if (contacts.empty())
       return report;
-    if (law.friction > 0)
-      throw RunError("the interior-point method solves frictionless problems only (Coulomb "
-                     "friction mu = " + std::to_string(law.friction) + ")");
-
+    require_frictionless(law, "interior-point");
     const FrictionlessProblem lcp(contacts, state);
     const Eigen::Index        n = lcp.size();
-    // The scaled problem: A' = S A S, b' = S b, y = x / s, S = D^(-1/2).
-    const Eigen::VectorXd       inv_root = lcp.diagonal.cwiseSqrt().cwiseInverse();
-    Eigen::SparseMatrix<double> A        = lcp.A;
-    for (Eigen::Index j = 0; j < n; ++j)
-      for (Eigen::SparseMatrix<double>::InnerIterator a(A, j); a; ++a)
-        a.valueRef() *= inv_root[a.row()] * inv_root[j];
-    const Eigen::VectorXd b         = lcp.b.cwiseProduct(inv_root);
-
-    Eigen::VectorXd y = lcp.x.cwiseQuotient(inv_root);
-    double          warm_sum = 0;
-    unsigned int    loaded      = 0;
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (y[i] > 0)
-        {
-          warm_sum += y[i];
-          ++loaded;
-        }
-    const double nu = 1e-2 * (loaded ? warm_sum / loaded : (b.cwiseAbs().mean() + 1e-300));
+    // The scaled problem (dem/mprgp.h).
+    FrictionlessProblem::Scaled       scaled   = lcp.scaled();
+    const Eigen::VectorXd            &inv_root = scaled.inv_root;
+    const Eigen::SparseMatrix<double> &A        = scaled.A;
+    const Eigen::VectorXd            &b        = scaled.b;
+    Eigen::VectorXd                  &y        = scaled.y;
+    const double nu = 1e-2 * ((y.array() > 0).any() ? lcp.mean_loaded(y) : b.cwiseAbs().mean() + 1e-300);
     y               = y.cwiseMax(nu);
     Eigen::VectorXd g = A * y + b, s = g.cwiseMax(nu);
 

@@ -1,6 +1,5 @@
 #include "dem/mprgp.h"
 
-#include "core/errors.h"
 #include "dem/frictionless_problem.h"
 
 #include <deal.II/base/parallel.h>
@@ -84,27 +83,23 @@ namespace tribo::dem
     SolveReport report;
     if (contacts.empty())
       return report;
-    if (law.friction > 0)
-      throw RunError("MPRGP solves frictionless problems only (Coulomb friction mu = " +
-                     std::to_string(law.friction) + ")");
-
+    require_frictionless(law, "MPRGP");
     const FrictionlessProblem lcp(contacts, state);
     const Index               n = lcp.size();
-    // The scaled problem (file comment): A' = S A S, b' = S b, y = x / s, S = D^(-1/2).
-    const Eigen::VectorXd       inv_root = lcp.diagonal.cwiseSqrt().cwiseInverse(); // S
-    Eigen::SparseMatrix<double> A        = lcp.A;
-    double                      norm_bound = 0; // ||A'|| <= max absolute column sum
+    // The scaled problem (file comment).
+    FrictionlessProblem::Scaled       scaled   = lcp.scaled();
+    const Eigen::VectorXd            &inv_root = scaled.inv_root;
+    const Eigen::SparseMatrix<double> &A        = scaled.A;
+    const Eigen::VectorXd            &b        = scaled.b;
+    Eigen::VectorXd                  &y        = scaled.y;
+    double norm_bound        = 0; // ||A'|| <= max absolute column sum
     for (Index j = 0; j < n; ++j)
       {
         double sum = 0;
         for (Eigen::SparseMatrix<double>::InnerIterator a(A, j); a; ++a)
-          {
-            a.valueRef() *= inv_root[a.row()] * inv_root[j];
-            sum += std::abs(a.value());
-          }
+          sum += std::abs(a.value());
         norm_bound = std::max(norm_bound, sum);
       }
-    const Eigen::VectorXd b         = lcp.b.cwiseProduct(inv_root);
     const double          alpha     = 1.9 / norm_bound;
     const double          gamma2    = 1.0; // Gamma^2
     const unsigned int    threads   = prm.threads;
@@ -120,7 +115,7 @@ namespace tribo::dem
       return sum;
     };
 
-    Eigen::VectorXd y = lcp.x.cwiseQuotient(inv_root), g(n), p(n), Ap(n), phi(n), beta(n);
+    Eigen::VectorXd g(n), p(n), Ap(n), phi(n), beta(n);
     // phi_j, beta_j and the split sums of entry j; with @p Ap_known, also phi.A'p.
     auto split_entry = [&](Index j, SplitSums &s, bool with_Ap) {
       s.worst = std::max(s.worst, std::abs(std::min(y[j], g[j])) * inv_root[j]);

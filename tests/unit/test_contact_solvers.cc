@@ -98,6 +98,28 @@ namespace
       v.segment<3>(3 * b) << s.bodies[b].velocity, s.bodies[b].spin;
     return v;
   }
+  /// Every global method gives the velocities of NLGS converged to 1e-12 after @p steps
+  /// steps of @p s, converged (the interior point: to its round-off floor), no fallback.
+  void expect_global_methods_match_converged_nlgs(const ParticleSystem &s, const ContactLaw &law,
+                                                  int steps)
+  {
+    const Eigen::VectorXd v_nlgs = velocities_after(s, law, nlgs_converged(), steps);
+    for (const SolverParameters &prm : global_methods())
+      {
+        std::vector<SolveReport> reports;
+        const Eigen::VectorXd    v = velocities_after(s, law, prm, steps, &reports);
+        EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << method_name(prm.method);
+        for (const auto &r : reports)
+          {
+            if (prm.method != SolverParameters::Method::interior_point)
+              {
+                EXPECT_TRUE(r.converged) << method_name(prm.method);
+              }
+            EXPECT_FALSE(r.fell_back);
+            EXPECT_LT(r.law_residual, reached(prm)) << method_name(prm.method);
+          }
+      }
+  }
 } // namespace
 
 TEST(ContactSolvers, SparseDelassusEqualsTheDenseOperator)
@@ -199,23 +221,7 @@ TEST(ContactSolvers, GlobalMethodsCarryTheAppliedForceOfADiscOnAWall)
 TEST(ContactSolvers, GlobalMethodsMatchConvergedNlgsOnAHyperstaticStack)
 {
   // Six contacts per disc: the impulses are not unique, the velocities are.
-  const ParticleSystem  s      = hexagonal_stack(400, 2);
-  const Eigen::VectorXd v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 40);
-  for (const SolverParameters &prm : global_methods())
-    {
-      std::vector<SolveReport> reports;
-      const Eigen::VectorXd    v = velocities_after(s, ContactLaw{}, prm, 40, &reports);
-      EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << method_name(prm.method);
-      for (const auto &r : reports)
-        {
-          if (prm.method != SolverParameters::Method::interior_point)
-            {
-              EXPECT_TRUE(r.converged) << method_name(prm.method);
-            }
-          EXPECT_FALSE(r.fell_back);
-          EXPECT_LT(r.law_residual, reached(prm)) << method_name(prm.method);
-        }
-    }
+  expect_global_methods_match_converged_nlgs(hexagonal_stack(400, 2), ContactLaw{}, 40);
 }
 
 TEST(ContactSolvers, GlobalMethodsMatchConvergedNlgsOnACohesiveCluster)
@@ -224,23 +230,7 @@ TEST(ContactSolvers, GlobalMethodsMatchConvergedNlgsOnACohesiveCluster)
   ContactLaw law;
   law.cohesion       = 50;
   law.cohesion_range = 0.05 * radius;
-  const ParticleSystem  s      = hexagonal_stack(-200, 1);
-  const Eigen::VectorXd v_nlgs = velocities_after(s, law, nlgs_converged(), 30);
-  for (const SolverParameters &prm : global_methods())
-    {
-      std::vector<SolveReport> reports;
-      const Eigen::VectorXd    v = velocities_after(s, law, prm, 30, &reports);
-      EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << method_name(prm.method);
-      for (const auto &r : reports)
-        {
-          if (prm.method != SolverParameters::Method::interior_point)
-            {
-              EXPECT_TRUE(r.converged) << method_name(prm.method);
-            }
-          EXPECT_FALSE(r.fell_back);
-          EXPECT_LT(r.law_residual, reached(prm)) << method_name(prm.method);
-        }
-    }
+  expect_global_methods_match_converged_nlgs(hexagonal_stack(-200, 1), law, 30);
 }
 
 TEST(ContactSolvers, GlobalMethodsWithElasMatchConvergedNlgs)
