@@ -9,6 +9,7 @@
 /// iteration solves twice with one factorisation of
 ///     K = A' + Y^-1 S        (symmetric positive definite for y, s > 0, whatever the
 ///                             redundancy of the contacts: no regularisation needed)
+/// (CHOLMOD's simplicial LL^T: faster than its supernodal one with reference BLAS here);
 /// - predictor: K dy = -r - s, ds = A' dy + r; the largest step alpha_a that keeps y, s >= 0
 ///   gives mu_a = (y + alpha_a dy).(s + alpha_a ds) / n and the centring sigma = (mu_a / mu)^3;
 /// - corrector: K dy = -r - s + (sigma mu - dy_a ds_a) / y, ds = A' dy + r;
