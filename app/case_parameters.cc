@@ -1,13 +1,16 @@
 #include "app/case_parameters.h"
 
 #include "app/particle_scenes.h"
+#include "app/sample_file.h"
 #include "core/errors.h"
 #include "coupling/first_body.h"
 
 #include <cmath>
+#include <filesystem>
 
 namespace tribo::app
 {
+  using dealii::Patterns::Anything;
   using dealii::Patterns::Bool;
   using dealii::Patterns::Double;
   using dealii::Patterns::Integer;
@@ -69,12 +72,13 @@ namespace tribo::app
                       "the one that reaches 1e-8 on dense packings). The last three stop at "
                       "Residual target; with friction their steps use NLGS and the log says so. "
                       "docs/performance.md compares them.");
-    prm.declare_entry("Residual target", "1.5e-3", Double(),
+    prm.declare_entry("Residual target", "1e-3", Double(),
                       "Active set, MPRGP, interior point: the solve ends when the law residual, max over "
                       "contacts of |min(r~, u~ / W_nn)| over the mean loaded impulse r~ "
                       "(dimensionless, docs/laws.md), is below this, in (0, 1). The default is "
-                      "what NLGS reaches on average at its default Tolerance (1e-4, Quad) in "
-                      "steady shear (docs/performance.md); 1e-11 is a converged solve.");
+                      "below the 1.2-1.5e-3 NLGS leaves on average at its default Tolerance (1e-4, "
+                      "Quad) in steady shear, where MPRGP at 1.5e-3 let overlaps grow past a radius "
+                      "(docs/performance.md); 1e-11 is a converged solve.");
     prm.declare_entry("Regularization", "1e-8", Double(),
                       "Active set: relative regularisation delta in [0, 1e-4] of the Newton matrix "
                       "W_FF + delta diag(W_FF) (redundant contacts make W_FF singular); it changes "
@@ -182,6 +186,13 @@ namespace tribo::app
     prm.declare_entry("Layer thickness", "0", Double(),
                       "Thickness of the profile layers, m (>= 0); 0: one mean diameter.");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
+    prm.declare_entry("Sample file", "", Anything(),
+                      "A CSV file of discs to start from instead of generated grains: header "
+                      "'x,y,r,body' (optionally ',vx,vy,spin'), SI units, body = grain, lower_wall or "
+                      "upper_wall (each wall one rigid body; without wall rows both walls are "
+                      "generated). A relative path is relative to the case file. Number of discs, "
+                      "Mean diameter, Diameter spread and Seed then do not act on the grains; "
+                      "Upper body model = rigid only (docs/outputs.md, 'Sample files').");
     prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
                       "rigid: a rough wall of discs with the mass of the first body (the paper's "
                       "classical model); fem: a plane-strain elastic body of that thickness "
@@ -329,6 +340,18 @@ namespace tribo::app
         sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");
         sc.seed = f.get_integer(S + "Seed");
         sc.upper_body_model = f.get(S + "Upper body model");
+        if (const std::string sample = f.get(S + "Sample file"); !sample.empty())
+          {
+            if (sc.upper_body_model != "rigid")
+              f.fail(S + "Sample file", "no sample file with Shear cell/Upper body model = " +
+                                          sc.upper_body_model + " (samples start the rigid-wall cell only, not yet the others)");
+            const std::filesystem::path given(sample);
+            sc.sample_file = std::filesystem::absolute(
+              given.is_absolute() ? given : std::filesystem::path(f.filename()).parent_path() / given)
+                               .lexically_normal()
+                               .string();
+            sc.sample = read_sample(sc.sample_file, sc.length);
+          }
         sc.sph_smoothing_ratio = f.get_checked(S + "Upper body smoothing length ratio",
                                                [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
         sc.upper_youngs_modulus = f.get_checked(S + "Upper body Young's modulus", positive, "a positive modulus in Pa");

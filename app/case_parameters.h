@@ -2,6 +2,7 @@
 /// @file The parameters of a case: declaration (with patterns, defaults and
 /// units) and validated reading into plain structs.
 
+#include "app/sample_file.h"
 #include "core/parameter_file.h"
 #include "coupling/first_body.h"
 #include "dem/contact_law.h"
@@ -44,6 +45,10 @@ namespace tribo::app
     unsigned int profile_samples;      ///< profile samples over the shearing phase
     double       layer_thickness;      ///< profile layer thickness, m (0: d)
     unsigned int seed;
+    /// Shear cell/Sample file as an absolute path ("" for generated grains), and its
+    /// discs (app/sample_file.h), read and checked with the parameters.
+    std::string             sample_file;
+    std::vector<SampleDisc> sample;
     /// The upper first body: rigid (a rough wall, a clump of discs), or deformable and
     /// touched through half-disc elements (dem/boundary.h): fem (the deal.II body of
     /// fem/), sph or mlp (particle blocks, coupling/particle_first_body.h).

@@ -253,6 +253,10 @@ namespace tribo::app
     for (const auto &s : o.overrides)
       file.set(s);
     const CaseParameters p = read_case_parameters(file);
+    // The sample file by its absolute path in parameters.prm: a resumed run, or one
+    // started from that file elsewhere, finds it.
+    if (!p.shear.sample_file.empty())
+      file.set("Shear cell/Sample file=" + p.shear.sample_file);
 #ifndef TRIBO_WITH_SPH_SCENES
     if (is_sph_scene(p.scene))
       throw InputError(o.case_file + ": Simulation/Scene = " + p.scene +

@@ -29,7 +29,9 @@
 #include <algorithm>
 #include <sstream>
 #include <cmath>
+#include <limits>
 #include <numeric>
+#include <tuple>
 #include <random>
 
 namespace tribo::app
@@ -46,46 +48,24 @@ namespace tribo::app
 
       void build(dem::ParticleSystem &s) override
       {
-        const auto  &k     = prm.shear;
-        const double d_max = k.mean_diameter * (1 + k.diameter_spread);
-        s.period           = k.length;
-
-        lower = add_wall(s, 0.0);
-        for (auto &d : s.bodies[lower].drive)
-          d = dem::Drive::velocity;
-
-        // Grains on a loose triangular lattice (neighbours 1.02 d_max apart).
-        const double       pitch   = 1.02 * d_max;
-        const unsigned int columns = std::max(1u, unsigned(k.length / pitch));
-        const double       dx      = k.length / columns;
-        const double       dy      = std::sqrt(std::max(pitch * pitch - 0.25 * dx * dx, 0.0));
-        const unsigned int rows    = (k.n_discs + columns - 1) / columns;
-        for (unsigned int i = 0; i < k.n_discs; ++i)
-          {
-            const unsigned int row = i / columns;
-            s.add_disc({(i % columns + 0.5 + 0.5 * (row % 2)) * dx, d_max + 0.5 * pitch + row * dy},
-                       0.5 * draw_diameter(), k.density);
-          }
-
-        const double upper_y = d_max + 0.5 * pitch + (rows - 1) * dy + pitch;
-        if (k.upper_body_model != "rigid")
-          build_deformable_upper_body(upper_y - 0.5 * lower_wall_diameter);
+        const auto &k = prm.shear;
+        s.period      = k.length;
+        if (!k.sample.empty())
+          build_from_sample(s);
         else
-          {
-            upper = add_wall(s, upper_y);
-            auto &u = s.bodies[upper];
-            u.drive = {{dem::Drive::velocity, dem::Drive::force, dem::Drive::velocity}};
-            const double discs_mass = u.mass;
-            u.mass                  = k.density * k.upper_body_thickness * k.length;
-            u.inertia *= u.mass / discs_mass;
-          }
-
-        profiles = std::make_unique<LayerProfiles>(
-          lower, upper, 0.5 * lower_wall_diameter, k.layer_thickness > 0 ? k.layer_thickness : k.mean_diameter);
+          build_generated(s);
+        unsigned int grains = 0;
         mean_grain_diameter = 0;
         for (const auto &d : s.discs)
           if (d.body != lower && d.body != upper)
-            mean_grain_diameter += 2 * d.radius / k.n_discs;
+            {
+              mean_grain_diameter += 2 * d.radius;
+              ++grains;
+            }
+        mean_grain_diameter /= grains;
+        profiles = std::make_unique<LayerProfiles>(
+          lower, upper, 0.5 * lower_wall_diameter,
+          k.layer_thickness > 0 ? k.layer_thickness : k.sample.empty() ? k.mean_diameter : mean_grain_diameter);
       }
 
       void before_step(dem::ParticleSystem &s, unsigned long step) override
@@ -401,6 +381,112 @@ namespace tribo::app
         else
           upper_y_to_surface = 0.5 * mean_diameter;
         return s.add_clump(centres, radii, k.density);
+      }
+
+      /// Grains on a loose triangular lattice (neighbours 1.02 d_max apart) between two
+      /// generated walls.
+      void build_generated(dem::ParticleSystem &s)
+      {
+        const auto  &k     = prm.shear;
+        const double d_max = k.mean_diameter * (1 + k.diameter_spread);
+        lower              = add_wall(s, 0.0);
+        for (auto &d : s.bodies[lower].drive)
+          d = dem::Drive::velocity;
+        const double       pitch   = 1.02 * d_max;
+        const unsigned int columns = std::max(1u, unsigned(k.length / pitch));
+        const double       dx      = k.length / columns;
+        const double       dy      = std::sqrt(std::max(pitch * pitch - 0.25 * dx * dx, 0.0));
+        const unsigned int rows    = (k.n_discs + columns - 1) / columns;
+        for (unsigned int i = 0; i < k.n_discs; ++i)
+          {
+            const unsigned int row = i / columns;
+            s.add_disc({(i % columns + 0.5 + 0.5 * (row % 2)) * dx, d_max + 0.5 * pitch + row * dy},
+                       0.5 * draw_diameter(), k.density);
+          }
+        const double upper_y = d_max + 0.5 * pitch + (rows - 1) * dy + pitch;
+        if (k.upper_body_model != "rigid")
+          build_deformable_upper_body(upper_y - 0.5 * lower_wall_diameter);
+        else
+          add_upper_wall(s, add_wall(s, upper_y));
+      }
+
+      /// The discs of Shear cell/Sample file (app/sample_file.h): its walls, or generated
+      /// walls below and above its grains.
+      void build_from_sample(dem::ParticleSystem &s)
+      {
+        const auto &k = prm.shear;
+        using Body    = SampleDisc::Body;
+        auto wall_of  = [&](Body body) {
+          std::vector<dem::Vec2> centres;
+          std::vector<double>    radii;
+          for (const SampleDisc &d : k.sample)
+            if (d.body == body)
+              {
+                centres.push_back(d.centre);
+                radii.push_back(d.radius);
+              }
+          const double mean_diameter = 2 * std::accumulate(radii.begin(), radii.end(), 0.0) / radii.size();
+          return std::make_pair(s.add_clump(centres, radii, k.density), mean_diameter);
+        };
+        double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
+        for (const SampleDisc &d : k.sample)
+          if (d.body == Body::grain)
+            {
+              bottom = std::min(bottom, d.centre.y() - d.radius);
+              top    = std::max(top, d.centre.y() + d.radius);
+            }
+        const bool walls_given = std::any_of(k.sample.begin(), k.sample.end(),
+                                             [](const SampleDisc &d) { return d.body != Body::grain; });
+        // Generated walls clear the grains by a hundredth of a diameter, whatever the
+        // wall discs drawn.
+        const double clearance = 0.5 * (k.wall_disc_diameter > 0 ? k.wall_disc_diameter
+                                                                 : k.mean_diameter * (1 + k.diameter_spread)) +
+                                 0.01 * mean_diameter_of(k.sample);
+        if (walls_given)
+          std::tie(lower, lower_wall_diameter) = wall_of(Body::lower_wall);
+        else
+          {
+            lower = add_wall(s, 0.0);
+            s.bodies[lower].position.y() += bottom - clearance;
+          }
+        for (auto &d : s.bodies[lower].drive)
+          d = dem::Drive::velocity;
+        for (const SampleDisc &d : k.sample)
+          if (d.body == Body::grain)
+            {
+              const unsigned int b     = s.add_disc(d.centre, d.radius, k.density);
+              s.bodies[b].velocity     = d.velocity;
+              s.bodies[b].spin         = d.spin;
+            }
+        if (walls_given)
+          {
+            auto [wall, diameter] = wall_of(Body::upper_wall);
+            upper_y_to_surface    = 0.5 * diameter;
+            add_upper_wall(s, wall);
+          }
+        else
+          add_upper_wall(s, add_wall(s, top + clearance));
+      }
+
+      /// Make @p wall the upper wall: free in y under the load, with the mass of the
+      /// first body it stands for.
+      void add_upper_wall(dem::ParticleSystem &s, unsigned int wall)
+      {
+        const auto &k = prm.shear;
+        upper         = wall;
+        auto &u       = s.bodies[upper];
+        u.drive       = {{dem::Drive::velocity, dem::Drive::force, dem::Drive::velocity}};
+        const double discs_mass = u.mass;
+        u.mass                  = k.density * k.upper_body_thickness * k.length;
+        u.inertia *= u.mass / discs_mass;
+      }
+
+      static double mean_diameter_of(const std::vector<SampleDisc> &sample)
+      {
+        double sum = 0;
+        for (const SampleDisc &d : sample)
+          sum += 2 * d.radius;
+        return sum / sample.size();
       }
 
       double grain_area(const dem::ParticleSystem &s) const

@@ -1,0 +1,38 @@
+#pragma once
+/// @file Shear-cell samples as files (Shear cell/Sample file, docs/outputs.md "Sample files").
+///
+/// A CSV file, one disc per line after the header `x,y,r,body` (optionally followed by
+/// `vx,vy,spin`): centre (m), radius (m), the body the disc belongs to (`grain`,
+/// `lower_wall` or `upper_wall`), and for grains an initial velocity (m/s) and spin
+/// (rad/s). Each wall is one rigid body made of its rows. Checks, each failing with the
+/// file, the line and the column: a header other than these columns, a row with another
+/// number of cells, a cell that is not a finite number, a radius <= 0, an unknown body, a
+/// grain outside [0, L) in x; then no grain at all, rows for one wall only, and walls that
+/// overlap (the upper wall's lowest point below the lower wall's highest).
+
+#include "dem/particle_system.h"
+
+#include <string>
+#include <vector>
+
+namespace tribo::app
+{
+  struct SampleDisc
+  {
+    enum class Body
+    {
+      grain,
+      lower_wall,
+      upper_wall
+    };
+    dem::Vec2 centre   = dem::Vec2::Zero(); ///< m
+    double    radius   = 0;                 ///< m
+    Body      body     = Body::grain;
+    dem::Vec2 velocity = dem::Vec2::Zero(); ///< m/s (grains)
+    double    spin     = 0;                 ///< rad/s (grains)
+  };
+
+  /// The discs of sample file @p path for a cell of period @p length (m); throws
+  /// InputError naming the file, line and column (see the file comment).
+  std::vector<SampleDisc> read_sample(const std::string &path, double length);
+} // namespace tribo::app
