@@ -314,7 +314,7 @@ namespace tribo::app
           fs::create_directories(dir / "fields");
           for (const char *name : {"statistics.csv", "results.h5", "summary.json", "log.txt",
                                    "original.prm", "parameters.prm", "profiles.csv", "mu.png",
-                                   "power.png", "profiles.png", "checkpoint.bin"})
+                                   "power.png", "profiles.png", "checkpoint.bin", "sample_final.csv"})
             fs::remove(dir / name);
           for (const auto &entry : fs::directory_iterator(dir / "fields"))
             fs::remove(entry.path());
@@ -555,6 +555,9 @@ namespace tribo::app
     const auto tables = scene->tables();
     for (const auto &[name, table] : tables)
       atomic_write((dir / (name + ".csv")).string(), table.to_csv());
+    // The last state as a sample, unless the run failed (its state may be what failed).
+    if (const std::string sample = status == "failed" ? "" : scene->final_sample(system); !sample.empty())
+      atomic_write((dir / "sample_final.csv").string(), sample);
     write_results_h5((dir / "results.h5").string(), stats, tables, resolved, scalars);
     atomic_write((dir / "summary.json").string(), summary.to_string());
     if (status == "complete")

@@ -29,6 +29,25 @@ namespace tribo::app
     }
   } // namespace
 
+  std::string sample_text(const dem::ParticleSystem &s, unsigned int lower, unsigned int upper)
+  {
+    std::ostringstream os;
+    os.precision(17);
+    os << "x,y,r,body,vx,vy,spin\n";
+    for (std::size_t d = 0; d < s.discs.size(); ++d)
+      {
+        const unsigned int     b = s.discs[d].body;
+        const dem::RigidBody  &body = s.bodies[b];
+        dem::Vec2              x    = s.wrap(s.disc_centre(d));
+        if (s.period > 0 && x.x() >= s.period) // a tiny negative x wraps to period itself
+          x.x() = 0;
+        os << x.x() << ',' << x.y() << ',' << s.discs[d].radius << ','
+           << (b == lower ? "lower_wall" : b == upper ? "upper_wall" : "grain") << ','
+           << body.velocity.x() << ',' << body.velocity.y() << ',' << body.spin << '\n';
+      }
+    return os.str();
+  }
+
   std::vector<SampleDisc> read_sample(const std::string &path, double length)
   {
     std::ifstream in(path);

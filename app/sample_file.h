@@ -3,8 +3,9 @@
 ///
 /// A CSV file, one disc per line after the header `x,y,r,body` (optionally followed by
 /// `vx,vy,spin`): centre (m), radius (m), the body the disc belongs to (`grain`,
-/// `lower_wall` or `upper_wall`), and for grains an initial velocity (m/s) and spin
-/// (rad/s). Each wall is one rigid body made of its rows. Checks, each failing with the
+/// `lower_wall` or `upper_wall`), and optionally an initial velocity (m/s) and spin
+/// (rad/s). Each wall is one rigid body made of its rows, moving as its first row says
+/// (the lower wall's velocity is then imposed by the cell). Checks, each failing with the
 /// file, the line and the column: a header other than these columns, a row with another
 /// number of cells, a cell that is not a finite number, a radius <= 0, an unknown body, a
 /// grain outside [0, L) in x; then no grain at all, rows for one wall only, and walls that
@@ -28,9 +29,15 @@ namespace tribo::app
     dem::Vec2 centre   = dem::Vec2::Zero(); ///< m
     double    radius   = 0;                 ///< m
     Body      body     = Body::grain;
-    dem::Vec2 velocity = dem::Vec2::Zero(); ///< m/s (grains)
-    double    spin     = 0;                 ///< rad/s (grains)
+    dem::Vec2 velocity = dem::Vec2::Zero(); ///< m/s
+    double    spin     = 0;                 ///< rad/s
   };
+
+  /// The sample file text of @p s (header x,y,r,body,vx,vy,spin; 17 significant digits,
+  /// so that reading it back gives the same doubles): the discs of body @p lower as
+  /// lower_wall, of @p upper as upper_wall, every other disc a grain, each with its
+  /// body's velocity and spin; x wrapped into [0, period).
+  std::string sample_text(const dem::ParticleSystem &s, unsigned int lower, unsigned int upper);
 
   /// The discs of sample file @p path for a cell of period @p length (m); throws
   /// InputError naming the file, line and column (see the file comment).

@@ -16,6 +16,7 @@
 // centres would be, less half a wall disc plus half a half-disc, so that all models
 // start from the same layer.
 #include "app/profiles.h"
+#include "app/sample_file.h"
 #include "app/scene.h"
 #include "app/steady_state.h"
 #include "core/errors.h"
@@ -92,6 +93,13 @@ namespace tribo::app
       }
 
       std::string description() const override { return body ? body->describe() : ""; }
+
+      /// The grains and both walls; none with a deformable upper body (a sample holds
+      /// discs only).
+      std::string final_sample(const dem::ParticleSystem &s) const override
+      {
+        return body ? "" : sample_text(s, lower, upper);
+      }
 
       void attach(dem::MoreauJean &mj) override
       {
@@ -416,17 +424,23 @@ namespace tribo::app
       {
         const auto &k = prm.shear;
         using Body    = SampleDisc::Body;
-        auto wall_of  = [&](Body body) {
+        // A wall from its rows, moving as its first row says.
+        auto wall_of = [&](Body body) {
           std::vector<dem::Vec2> centres;
           std::vector<double>    radii;
+          const SampleDisc      *first = nullptr;
           for (const SampleDisc &d : k.sample)
             if (d.body == body)
               {
                 centres.push_back(d.centre);
                 radii.push_back(d.radius);
+                first = first ? first : &d;
               }
-          const double mean_diameter = 2 * std::accumulate(radii.begin(), radii.end(), 0.0) / radii.size();
-          return std::make_pair(s.add_clump(centres, radii, k.density), mean_diameter);
+          const double       mean_diameter = 2 * std::accumulate(radii.begin(), radii.end(), 0.0) / radii.size();
+          const unsigned int wall          = s.add_clump(centres, radii, k.density);
+          s.bodies[wall].velocity          = first->velocity;
+          s.bodies[wall].spin              = first->spin;
+          return std::make_pair(wall, mean_diameter);
         };
         double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
         for (const SampleDisc &d : k.sample)

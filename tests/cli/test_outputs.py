@@ -9,6 +9,7 @@ here: only what each output means, as docs/outputs.md defines it.
 Usage: /usr/bin/python3 test_outputs.py /path/to/tribo
 """
 
+import csv
 import math
 import os
 import re
@@ -115,7 +116,7 @@ class RunOnce:
     def tables(self):
         """The scene's extra tables: {NAME: (header, columns)} of every NAME.csv."""
         return {f[:-4]: read_csv(os.path.join(self.out, f)) for f in os.listdir(self.out)
-                if f.endswith(".csv") and f != "statistics.csv"}
+                if f.endswith(".csv") and f not in ("statistics.csv", "sample_final.csv")}
 
     def test_results_h5(self):
         with h5py.File(os.path.join(self.out, "results.h5"), "r") as f:
@@ -470,6 +471,27 @@ class ShearRun(RunOnce):
             self.assertEqual(int(f["parameters"].attrs["Shear cell/Number of discs"]), self.N)
             self.assertEqual(f["parameters"].attrs["Output/Plots"], self.SECTIONS["Output"]["Plots"])
 
+    def test_sample_final(self):
+        """sample_final.csv: every disc once, grains inside the period, the radii those of
+        the first snapshot, each wall's rows moving together."""
+        with open(os.path.join(self.out, "sample_final.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual(list(rows[0]), ["x", "y", "r", "body", "vx", "vy", "spin"])
+        self.assertEqual(len(rows), self.summary["n_discs"])
+        by_body = {b: [r for r in rows if r["body"] == b] for b in ("grain", "lower_wall", "upper_wall")}
+        self.assertEqual(len(by_body["grain"]), self.N)
+        self.assertEqual(len(by_body["lower_wall"]), 10)
+        self.assertEqual(len(by_body["upper_wall"]), 10)
+        for r in by_body["grain"]:
+            self.assertTrue(0 <= float(r["x"]) < self.L, r)
+        d = self.discs()
+        np.testing.assert_allclose(sorted(float(r["r"]) for r in by_body["grain"]), sorted(d["grains"]), rtol=1e-6)
+        for wall in ("lower_wall", "upper_wall"):
+            self.assertEqual(len({(r["vx"], r["vy"], r["spin"]) for r in by_body[wall]}), 1, wall)
+        # The upper wall's rows sit at its final height (statistics.csv, last row).
+        upper_y = np.mean([float(r["y"]) for r in by_body["upper_wall"]])
+        self.assertAlmostEqual(upper_y / self.stats["upper_wall_y"][-1], 1, delta=1e-9)
+
     def test_results_keys(self):
         r = self.summary["results"]
         self.assertEqual(list(r), SLIDING_RESULTS if self.sliding else COMPACTION_RESULTS)
@@ -573,7 +595,7 @@ class Compaction(ShearRun, unittest.TestCase):
 
     N, RAMP_TIME, SHEAR_START, END_TIME, FIELD_INTERVAL = 60, 1e-7, 1e-6, 4e-7, 50
     sliding = False
-    EXTRA_FILES = ["profiles.csv"]
+    EXTRA_FILES = ["profiles.csv", "sample_final.csv"]
     SECTIONS = shear_sections("60", "4e-7", "1e-6", "1e-7", "false",
                               Output={"Field interval": "50"})
 
@@ -602,7 +624,7 @@ class Sliding(ShearRun, unittest.TestCase):
     N, RAMP_TIME, SHEAR_START, END_TIME, FIELD_INTERVAL = 100, 2e-7, 4e-7, 2e-6, 500
     V, SAMPLES = 5.0, 50
     sliding = True
-    EXTRA_FILES = ["profiles.csv"] + PLOTS
+    EXTRA_FILES = ["profiles.csv", "sample_final.csv"] + PLOTS
     SECTIONS = shear_sections("100", "2e-6", "4e-7", "2e-7", "true",
                               **{"Shear cell": {"Sliding velocity": "5", "Profile samples": "50"},
                                  "Output": {"Field interval": "500"}})
@@ -779,7 +801,7 @@ class Plots(TempDirTestCase):
             f.write("mine")
         r = run(["run", "case.prm", "--output", "out", "--quiet", "--set", "Output/Plots=false"], cwd=self.tmp)
         self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertEqual(sorted(os.listdir(out)), sorted(FILES + ["profiles.csv", "notes.txt"]))
+        self.assertEqual(sorted(os.listdir(out)), sorted(FILES + ["profiles.csv", "sample_final.csv", "notes.txt"]))
 
     def test_plots_of_one_row(self):  # (TypeError: len() of numpy.float64): reported, to be fixed there
         """A single statistics row (Statistics interval beyond the run) still gets its plots."""
