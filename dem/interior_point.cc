@@ -42,7 +42,11 @@ namespace tribo::dem
     const Eigen::SparseMatrix<double> &A        = scaled.A;
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
-    const double nu = 1e-2 * ((y.array() > 0).any() ? lcp.mean_loaded(y) : b.cwiseAbs().mean() + 1e-300);
+    // The scale of y: the warm start's loaded impulses, or the free velocities' (A'y = -b'
+    // at a solution with unit diagonal), whichever is larger: a warm start of tiny
+    // impulses must not shrink the start (nor the target) step after step.
+    const double nu = 1e-2 * std::max({(y.array() > 0).any() ? lcp.mean_loaded(y) : 0.0,
+                                        b.cwiseAbs().mean(), 1e-300});
     y               = y.cwiseMax(nu);
     Eigen::VectorXd g = A * y + b, s = g.cwiseMax(nu);
 
@@ -72,6 +76,10 @@ namespace tribo::dem
     // Round-off floor: below 1e-6 of the mean impulse, two iterations in a row that do not
     // halve the natural map end the solve (K's condition grows like 1 / mu).
     double       worst = natural_map(), last_worst = std::numeric_limits<double>::infinity();
+    // The best iterate (smallest natural map) is the one applied: a diverging iteration
+    // cannot hand the bodies a worse solution than it had.
+    double          best_worst = worst;
+    Eigen::VectorXd best_y = y, best_g = g;
     unsigned int stalled = 0;
     // The iterate's mean loaded impulse: y is interior, so the contacts whose impulse
     // exceeds their velocity (y_i > g_i in the scaled units; the others head for zero).
@@ -131,8 +139,23 @@ namespace tribo::dem
         s += alpha * ds;
         g     = A * y + b;
         worst = natural_map();
+        if (!std::isfinite(worst))
+          {
+            report.converged = false;
+            break;
+          }
+        if (worst < best_worst)
+          {
+            best_worst = worst;
+            best_y     = y;
+            best_g     = g;
+          }
       }
-    lcp.apply(y.cwiseProduct(inv_root), contacts, state);
+    // Contacts whose velocity exceeds their impulse are open: their interior impulse
+    // (about mu / s) goes to zero rather than into the next step's warm start.
+    for (Eigen::Index i = 0; i < n; ++i)
+      best_y[i] = best_y[i] > best_g[i] ? best_y[i] * inv_root[i] : 0.0;
+    lcp.apply(best_y, contacts, state);
     return report;
   }
 } // namespace tribo::dem

@@ -14,8 +14,9 @@
 ///   gives mu_a = (y + alpha_a dy).(s + alpha_a ds) / n and the centring sigma = (mu_a / mu)^3;
 /// - corrector: K dy = -r - s + (sigma mu - dy_a ds_a) / y, ds = A' dy + r;
 /// - step: 0.995 of the largest step that keeps y, s > 0, the same for both.
-/// Start: y_0 = max(warm start, nu), s_0 = max(A'y_0 + b', nu), nu a hundredth of the mean
-/// warm-started impulse (scaled). It stops at the natural-map test of the other global
+/// Start: y_0 = max(warm start, nu), s_0 = max(A'y_0 + b', nu), nu a hundredth of the
+/// larger of the mean warm-started impulse and the mean |b'| (scaled). The iterate with the
+/// smallest natural map is applied, its open contacts (y_i <= g_i) at zero impulse. It stops at the natural-map test of the other global
 /// methods (SolverParameters::residual_target, the solution being y projected onto y >= 0)
 /// or after SolverParameters::max_factorizations, or when K cannot be factorised even with
 /// 1e-10 I added (a numerically singular K near the solution), or when, below 1e-6 of the

@@ -218,6 +218,42 @@ TEST(ContactSolvers, GlobalMethodsCarryTheAppliedForceOfADiscOnAWall)
     }
 }
 
+TEST(ContactSolvers, GlobalMethodsKeepAnOpenContactQuietUntilItCloses)
+{
+  // A disc 10 nm above a fixed wall (inside the detection distance: a contact that stays
+  // open for about 350 steps), pulled down by F: it lands and then rests, held by r_n = h F.
+  // The interior-point method once carried the interior impulses of the open contact
+  // into its warm start, shrinking its start step after step until the landing blew up.
+  for (SolverParameters prm : global_methods())
+    {
+      prm.residual_target = 1e-3;
+      ParticleSystem s;
+      const unsigned wall = s.add_clump({{-1e-6, 0}, {0, 0}, {1e-6, 0}}, {radius, radius, radius}, rho);
+      for (auto &k : s.bodies[wall].drive)
+        k = Drive::velocity;
+      const unsigned disc     = s.add_disc({0, 2 * radius + 1e-8}, radius, rho);
+      const double   F        = -1e-3; // 350 steps to land
+      s.bodies[disc].drive[1] = Drive::force;
+      s.bodies[disc].load[1]  = F;
+      MoreauJean   mj(0.5, ContactLaw{}, prm, 0.1 * radius);
+      const double h = 1e-9;
+      double       fastest = 0;
+      for (int i = 0; i < 3000; ++i)
+        {
+          mj.step(s, h);
+          fastest = std::max(fastest, s.bodies[disc].velocity.norm());
+        }
+      const std::string name = method_name(prm.method);
+      // Free fall over 10 nm under F / m: v = sqrt(2 a d), about 0.1 m/s.
+      const double a = std::abs(F) / s.bodies[disc].mass;
+      EXPECT_LT(fastest, 2 * std::sqrt(2 * a * 1e-8)) << name;
+      EXPECT_NEAR(mj.contact_force()[disc].y(), -F, 1e-3 * std::abs(F)) << name;
+      // IQS freezes the landing's overlap, at most (1 - theta) h v.
+      EXPECT_LE(s.bodies[disc].position.y(), 2 * radius) << name;
+      EXPECT_GE(s.bodies[disc].position.y(), 2 * radius - 0.5 * h * fastest) << name;
+    }
+}
+
 TEST(ContactSolvers, GlobalMethodsMatchConvergedNlgsOnAHyperstaticStack)
 {
   // Six contacts per disc: the impulses are not unique, the velocities are.
