@@ -133,12 +133,18 @@ class SampleRun(tribo_cli.TempDirTestCase):
                  for r in rows if r[3] == "grain")
         self.assertAlmostEqual(float(stats[0]["kinetic_energy_third_body"]) / ke, 1, delta=1e-3)
 
-    def test_parameters_name_the_sample_by_its_absolute_path(self):
-        self.run_sample(sample_rows())
-        with open(os.path.join(self.tmp, "out", "parameters.prm")) as f:
-            text = f.read()
-        self.assertIn("set Sample file", text)
-        self.assertIn(os.path.join(os.path.realpath(self.tmp), "sample.csv"), text.replace(self.tmp, os.path.realpath(self.tmp)))
+    def test_parameters_repeat_the_run_from_elsewhere(self):
+        """parameters.prm names the sample by its absolute path: run from another directory,
+        it starts from the same sample and repeats the first step exactly."""
+        _, stats = self.run_sample(sample_rows())
+        elsewhere = os.path.join(self.tmp, "elsewhere")
+        os.makedirs(elsewhere)
+        r = run(["run", os.path.join(self.tmp, "out", "parameters.prm"), "--output", "again", "--quiet"],
+                cwd=elsewhere)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(elsewhere, "again", "statistics.csv")) as f:
+            again = list(csv.DictReader(f))
+        self.assertEqual(again[0], stats[0])
 
     def test_walls_generated_around_a_sample_of_grains(self):
         rows = sample_rows(walls=False)
