@@ -5,6 +5,9 @@
 #include "core/errors.h"
 #include "coupling/first_body.h"
 
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
+
 #include <cmath>
 #include <filesystem>
 
@@ -15,6 +18,50 @@ namespace tribo::app
   using dealii::Patterns::Double;
   using dealii::Patterns::Integer;
   using dealii::Patterns::Selection;
+
+  namespace
+  {
+    /// Shear cell/Initial state = @p given: the final sample and time of a completed
+    /// rigid-wall shear run, checked against the case @p p (its Length, time step and End
+    /// time) into p.shear.initial_state, p.shear.sample and p.start_time.
+    void read_initial_state(const ParameterFile &f, const std::string &given, CaseParameters &p)
+    {
+      namespace fs         = std::filesystem;
+      const std::string E  = "Shear cell/Initial state";
+      auto             &sc = p.shear;
+      if (!sc.sample_file.empty())
+        f.fail(E, "no initial state together with a Shear cell/Sample file (each gives the discs)");
+      if (sc.upper_body_model != "rigid")
+        f.fail(E, "no initial state with Shear cell/Upper body model = " + sc.upper_body_model +
+                    " (states start the rigid-wall cell only, not yet the others)");
+      const fs::path dir = fs::absolute(fs::path(given).is_absolute()
+                                          ? fs::path(given)
+                                          : fs::path(f.filename()).parent_path() / given)
+                             .lexically_normal();
+      sc.initial_state = dir.string();
+      const RunRecord run = read_run_record(dir.string());
+      if (run.status != "complete" || run.scene != "shear" || !fs::is_regular_file(dir / "sample_final.csv"))
+        f.fail(E, "the directory of a completed shear run with a rigid upper wall (" + dir.string() +
+                    (run.status.empty() ? " has no readable summary.json"
+                                        : " has status '" + run.status + "', scene '" + run.scene + "'" +
+                                            (fs::is_regular_file(dir / "sample_final.csv") ? ""
+                                                                                           : ", no sample_final.csv")) +
+                    ")");
+      if (std::abs(run.length - sc.length) > 1e-12 * sc.length)
+        f.fail(E, "a run of this case's Shear cell/Length = " + to_text(sc.length) + " m (" + dir.string() +
+                    " has " + to_text(run.length) + " m)");
+      const double steps = run.simulated_time / p.time_step;
+      if (std::abs(steps - std::round(steps)) > 1e-6 * std::max(1.0, steps))
+        f.fail(E, "a state at a whole number of time steps (" + dir.string() + " ends at t0 = " +
+                    to_text(run.simulated_time) + " s, " + to_text(steps) + " steps of Simulation/Time step = " +
+                    to_text(p.time_step) + " s)");
+      if (p.end_time <= run.simulated_time)
+        f.fail(E, "a state before Simulation/End time = " + to_text(p.end_time) + " s (" + dir.string() +
+                    " ends at t0 = " + to_text(run.simulated_time) + " s)");
+      p.start_time = std::round(steps) * p.time_step;
+      sc.sample    = read_sample((dir / "sample_final.csv").string(), sc.length);
+    }
+  } // namespace
 
   void declare_case_parameters(dealii::ParameterHandler &prm)
   {
@@ -193,6 +240,14 @@ namespace tribo::app
                       "generated). A relative path is relative to the case file. Number of discs, "
                       "Mean diameter, Diameter spread and Seed then do not act on the grains; "
                       "Upper body model = rigid only (docs/outputs.md, 'Sample files').");
+    prm.declare_entry("Initial state", "", Anything(),
+                      "The directory of a completed rigid-wall shear run (e.g. a compaction-only run, "
+                      "Shear start >= End time) to go on from: the case starts at that run's final time "
+                      "t0 from its sample_final.csv (grains, walls, their velocities; not the contact "
+                      "impulses), with this case's parameters from t0 on; the steps before t0 are not "
+                      "run. t0 must be a whole number of time steps and before End time; the Length "
+                      "must be the run's. A relative path is relative to the case file. Not with "
+                      "Sample file; Upper body model = rigid only (docs/outputs.md, 'Initial states').");
     prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
                       "rigid: a rough wall of discs with the mass of the first body (the paper's "
                       "classical model); fem: a plane-strain elastic body of that thickness "
@@ -352,6 +407,8 @@ namespace tribo::app
                                .string();
             sc.sample = read_sample(sc.sample_file, sc.length);
           }
+        if (const std::string state = f.get(S + "Initial state"); !state.empty())
+          read_initial_state(f, state, p);
         sc.sph_smoothing_ratio = f.get_checked(S + "Upper body smoothing length ratio",
                                                [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
         sc.upper_youngs_modulus = f.get_checked(S + "Upper body Young's modulus", positive, "a positive modulus in Pa");
@@ -399,5 +456,32 @@ namespace tribo::app
     b.compaction_damping = k.shear_start > 0 ? k.upper_compaction_damping : 0.0;
     b.smoothing_ratio    = k.sph_smoothing_ratio;
     return b;
+  }
+
+  RunRecord read_run_record(const std::string &dir)
+  {
+    namespace fs = std::filesystem;
+    RunRecord r;
+    try
+      {
+        boost::property_tree::ptree tree;
+        boost::property_tree::read_json((fs::path(dir) / "summary.json").string(), tree);
+        r.status         = tree.get<std::string>("status", "");
+        r.scene          = tree.get<std::string>("scene", "");
+        r.simulated_time = tree.get<double>("simulated_time", 0.0);
+      }
+    catch (const std::exception &)
+      {} // status "": no readable summary
+    try
+      {
+        dealii::ParameterHandler prm;
+        declare_case_parameters(prm);
+        ParameterFile parameters(prm);
+        parameters.parse((fs::path(dir) / "parameters.prm").string());
+        r.length = parameters.get_double("Shear cell/Length");
+      }
+    catch (const std::exception &)
+      {} // length 0: no readable parameters
+    return r;
   }
 } // namespace tribo::app

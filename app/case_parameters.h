@@ -49,6 +49,9 @@ namespace tribo::app
     /// discs (app/sample_file.h), read and checked with the parameters.
     std::string             sample_file;
     std::vector<SampleDisc> sample;
+    /// Shear cell/Initial state as an absolute directory ("" for none): its
+    /// sample_final.csv is in @c sample, its final time in CaseParameters::start_time.
+    std::string             initial_state;
     /// The upper first body: rigid (a rough wall, a clump of discs), or deformable and
     /// touched through half-disc elements (dem/boundary.h): fem (the deal.II body of
     /// fem/), sph or mlp (particle blocks, coupling/particle_first_body.h).
@@ -74,6 +77,9 @@ namespace tribo::app
     std::string scene;
     double      time_step;
     double      end_time;
+    /// s: the time the run starts at, 0 unless Shear cell/Initial state gives a later one
+    /// (a whole number of time steps; the steps before are not run).
+    double      start_time = 0;
     double      theta;
     dem::ContactLaw     law;
     double              detection_distance; ///< m; 0: a tenth of the smallest radius
@@ -87,6 +93,17 @@ namespace tribo::app
     CollisionParameters  collision;
     ShearCellParameters  shear;
   };
+
+  /// What a finished run directory says of itself (its summary.json and parameters.prm),
+  /// for a case that goes on from it (Shear cell/Initial state) or exports its snapshots.
+  struct RunRecord
+  {
+    std::string status;             ///< summary.json "status" ("" if unreadable)
+    std::string scene;              ///< summary.json "scene"
+    double      simulated_time = 0; ///< s, summary.json "simulated_time"
+    double      length         = 0; ///< m, parameters.prm Shear cell/Length
+  };
+  RunRecord read_run_record(const std::string &dir);
 
   /// Declare every entry of a case file.
   void declare_case_parameters(dealii::ParameterHandler &prm);

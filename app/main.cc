@@ -1,10 +1,12 @@
 // tribo: the command-line front end.
 #include "app/run.h"
+#include "app/sample_file.h"
 #include "app/study.h"
 #include "core/errors.h"
 
 #include <deal.II/base/mpi.h>
 
+#include <cmath>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -27,6 +29,9 @@ Usage:
   tribo tradeoff STUDY.prm [--output DIR] [--quiet]
       A study with Design = tradeoff: ladders of settings, cost and error against the
       reference in tradeoff.csv/.md/.png (docs/tradeoff.md).
+  tribo sample DIR [--time T] > sample.csv
+      Print a shear run's snapshot (the one nearest T s, else the last) as a sample file
+      that Shear cell/Sample file takes (docs/outputs.md, "Sample files").
   tribo params
       Print every parameter with its default, allowed values and unit: a case to start from.
   tribo --help | --version
@@ -60,6 +65,41 @@ int main(int argc, char **argv)
           if (args.size() > 1)
             usage_error("'tribo params' takes no arguments");
           std::cout << tribo::app::parameter_reference();
+          return tribo::exit_ok;
+        }
+      if (args[0] == "sample")
+        {
+          std::string dir;
+          double      time = NAN;
+          for (std::size_t i = 1; i < args.size(); ++i)
+            {
+              if (args[i] == "--time" && i + 1 < args.size())
+                {
+                  const std::string &v = args[++i];
+                  std::size_t        used = 0;
+                  try
+                    {
+                      time = std::stod(v, &used);
+                    }
+                  catch (const std::exception &)
+                    {
+                      used = 0;
+                    }
+                  if (used != v.size() || v.empty() || !std::isfinite(time))
+                    usage_error("--time '" + v + "': expected a time in s");
+                }
+              else if (!args[i].empty() && args[i][0] == '-')
+                usage_error("unknown option '" + args[i] + "' for 'tribo sample'");
+              else if (dir.empty())
+                dir = args[i];
+              else
+                usage_error("more than one run directory");
+            }
+          if (dir.empty())
+            usage_error("'tribo sample' needs a run directory");
+          const tribo::app::SampleSnapshot s = tribo::app::sample_snapshot(dir, time);
+          std::cerr << "tribo sample: " << s.path << " (t = " << s.time << " s)" << std::endl;
+          std::cout << s.text;
           return tribo::exit_ok;
         }
       if (args[0] == "study" || args[0] == "tradeoff")

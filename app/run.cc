@@ -67,6 +67,10 @@ namespace tribo::app
           contacts.gap.push_back(c.gap);
         }
       writer.write(t, discs, contacts);
+      // The discs as a sample file next to the snapshot (`tribo sample DIR --time T`),
+      // exact where the VTU's Float32 is not.
+      if (const std::string sample = scene.sample(s); !sample.empty())
+        atomic_write(sample_snapshot_path(writer.directory(), writer.n_snapshots() - 1), sample);
       // The scene's own fields, SERIES_NNNNN.vtu, indexed in SERIES.pvd.
       for (const std::string &file : scene.write_fields(writer.directory(), writer.n_snapshots() - 1))
         writer.index(file.substr(0, file.rfind('_')), t, file);
@@ -257,6 +261,8 @@ namespace tribo::app
     // started from that file elsewhere, finds it.
     if (!p.shear.sample_file.empty())
       file.set("Shear cell/Sample file=" + p.shear.sample_file);
+    if (!p.shear.initial_state.empty())
+      file.set("Shear cell/Initial state=" + p.shear.initial_state);
 #ifndef TRIBO_WITH_SPH_SCENES
     if (is_sph_scene(p.scene))
       throw InputError(o.case_file + ": Simulation/Scene = " + p.scene +
@@ -365,6 +371,9 @@ namespace tribo::app
     dem::MoreauJean mj(p.theta, p.law, solver, distance);
     scene->attach(mj);
     const unsigned long n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
+    // A run that goes on from an initial state starts at its step (a whole number of steps,
+    // checked with the parameters).
+    const unsigned long first_step = std::lround(p.start_time / h);
     {
       std::ostringstream os;
       os << "scene " << p.scene << ": " << system.bodies.size() << " bodies, " << system.discs.size()
@@ -372,6 +381,13 @@ namespace tribo::app
       log(os.str());
       if (!scene->description().empty())
         log(scene->description());
+      if (first_step > 0)
+        {
+          std::ostringstream state;
+          state << "starting from the state of " << p.shear.initial_state << " at t = " << first_step * h
+                << " s (step " << first_step << "; its sample_final.csv, without contact impulses)";
+          log(state.str());
+        }
       if (p.solver.method != dem::SolverParameters::Method::nlgs && p.law.friction > 0)
         log("Solver/Method = " + dem::method_name(p.solver.method) +
             " solves frictionless problems only: with Coulomb friction (mu = " +
@@ -394,8 +410,8 @@ namespace tribo::app
     FieldWriter fields((dir / "fields").string());
 
     std::string   status = "complete", failure;
-    unsigned long step = 0, total_iterations = 0, non_converged = 0, max_iterations = 0;
-    double        worst_overlap = 0, t = 0, max_residual = 0;
+    unsigned long step = first_step, total_iterations = 0, non_converged = 0, max_iterations = 0;
+    double        worst_overlap = 0, t = first_step * h, max_residual = 0;
     // The law residual (dem/law_residual.h) over the steps, and the active set's work.
     double        max_law_residual = 0, sum_law_residual = 0, max_gap_violation = 0;
     unsigned long total_factorizations = 0, fallbacks = 0;
@@ -431,7 +447,7 @@ namespace tribo::app
         log(os.str());
       }
     else
-      write_fields(fields, 0, system, mj, h, *scene);
+      write_fields(fields, t, system, mj, h, *scene);
 
     ProgressLine  progress(n_steps * h, !o.quiet);
     auto          last_flush = std::chrono::steady_clock::now();
@@ -519,20 +535,23 @@ namespace tribo::app
       summary.set("signal", long(stop_requested()));
     summary.set("scene", p.scene);
     summary.set("time_step", h);
-    summary.set("steps", long(step));
-    summary.set("steps_planned", long(n_steps));
+    // Steps run by this case: from its start (0, or an initial state's step) on.
+    const unsigned long steps_run = step - first_step;
+    summary.set("steps", long(steps_run));
+    summary.set("steps_planned", long(n_steps - first_step));
+    summary.set("start_time", first_step * h);
     summary.set("simulated_time", t);
     summary.set("wall_time", wall);
     summary.set("nlgs_iterations_total", long(total_iterations));
-    summary.set("nlgs_iterations_mean", step ? double(total_iterations) / step : 0.0);
+    summary.set("nlgs_iterations_mean", steps_run ? double(total_iterations) / steps_run : 0.0);
     summary.set("nlgs_iterations_max", long(max_iterations));
     summary.set("nlgs_residual_max", max_residual);
     summary.set("nlgs_non_converged_steps", long(non_converged));
     summary.set("law_residual_max", max_law_residual);
-    summary.set("law_residual_mean", step ? sum_law_residual / step : 0.0);
+    summary.set("law_residual_mean", steps_run ? sum_law_residual / steps_run : 0.0);
     summary.set("gap_violation_max", max_gap_violation);
     summary.set("solver_method", dem::method_name(p.solver.method));
-    summary.set("factorizations_mean", step ? double(total_factorizations) / step : 0.0);
+    summary.set("factorizations_mean", steps_run ? double(total_factorizations) / steps_run : 0.0);
     summary.set("active_set_fallbacks", long(fallbacks));
     summary.set("max_overlap", worst_overlap);
     summary.set("max_overlap_over_min_radius", worst_overlap / system.min_radius());
@@ -548,7 +567,7 @@ namespace tribo::app
       scene->summarize(system, stats, scene_results);
     summary.set("results", scene_results);
 
-    std::map<std::string, double> scalars = {{"time_step", h}, {"steps", double(step)},
+    std::map<std::string, double> scalars = {{"time_step", h}, {"steps", double(steps_run)},
                                              {"simulated_time", t}, {"wall_time", wall},
                                              {"complete", status == "complete" ? 1.0 : 0.0}};
     atomic_write((dir / "statistics.csv").string(), stats.to_csv());
@@ -556,7 +575,7 @@ namespace tribo::app
     for (const auto &[name, table] : tables)
       atomic_write((dir / (name + ".csv")).string(), table.to_csv());
     // The last state as a sample, unless the run failed (its state may be what failed).
-    if (const std::string sample = status == "failed" ? "" : scene->final_sample(system); !sample.empty())
+    if (const std::string sample = status == "failed" ? "" : scene->sample(system); !sample.empty())
       atomic_write((dir / "sample_final.csv").string(), sample);
     write_results_h5((dir / "results.h5").string(), stats, tables, resolved, scalars);
     atomic_write((dir / "summary.json").string(), summary.to_string());
@@ -574,17 +593,17 @@ namespace tribo::app
       }
 
     std::ostringstream os;
-    os << "status " << status << ": " << step << " steps in " << wall << " s, "
-       << (step ? double(total_iterations) / step : 0.0)
+    os << "status " << status << ": " << steps_run << " steps in " << wall << " s, "
+       << (steps_run ? double(total_iterations) / steps_run : 0.0)
        << (p.solver.method == dem::SolverParameters::Method::mprgp ? " NLGS sweeps and MPRGP products"
                                                                    : " NLGS sweeps")
        << " per step, "
        << non_converged << " steps not converged, law residual mean "
-       << (step ? sum_law_residual / step : 0.0) << " max " << max_law_residual
+       << (steps_run ? sum_law_residual / steps_run : 0.0) << " max " << max_law_residual
        << ", worst overlap " << worst_overlap << " m";
     if (p.solver.method == dem::SolverParameters::Method::active_set ||
         p.solver.method == dem::SolverParameters::Method::interior_point)
-      os << ", " << (step ? double(total_factorizations) / step : 0.0) << " factorisations per step";
+      os << ", " << (steps_run ? double(total_factorizations) / steps_run : 0.0) << " factorisations per step";
     if (p.solver.method == dem::SolverParameters::Method::active_set)
       os << ", " << fallbacks << " NLGS fallbacks";
     if (timing.steps > 0)

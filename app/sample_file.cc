@@ -1,9 +1,12 @@
 #include "app/sample_file.h"
 
+#include "app/case_parameters.h"
 #include "core/errors.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -144,5 +147,57 @@ namespace tribo::app
                            to_text(upper_bottom) + " m, the lower wall up to y = " + to_text(lower_top) + " m");
       }
     return discs;
+  }
+
+  std::string sample_snapshot_path(const std::string &fields_dir, unsigned int index)
+  {
+    char name[32];
+    std::snprintf(name, sizeof name, "sample_%05u.csv", index);
+    return (std::filesystem::path(fields_dir) / name).string();
+  }
+
+  SampleSnapshot sample_snapshot(const std::string &run_dir, double time)
+  {
+    namespace fs         = std::filesystem;
+    const fs::path index = fs::path(run_dir) / "fields" / "discs.pvd";
+    std::ifstream  in(index);
+    if (!in)
+      throw InputError("tribo sample " + run_dir + ": no snapshot index " + index.string() +
+                       " (expected the output directory of a run)");
+    // One snapshot per <DataSet timestep="T" ... file="discs_NNNNN.vtu"/>, in time order.
+    std::vector<std::pair<double, std::string>> snapshots;
+    std::string                                 line;
+    while (std::getline(in, line))
+      {
+        const auto t = line.find("timestep=\""), f = line.find("file=\"");
+        if (t == std::string::npos || f == std::string::npos)
+          continue;
+        const std::string file = line.substr(f + 6, line.find('"', f + 6) - f - 6);
+        snapshots.emplace_back(std::stod(line.substr(t + 10)), file);
+      }
+    if (snapshots.empty())
+      throw InputError("tribo sample " + run_dir + ": " + index.string() + " lists no snapshot");
+    auto chosen = snapshots.end() - 1;
+    if (!std::isnan(time))
+      chosen = std::min_element(snapshots.begin(), snapshots.end(), [&](const auto &a, const auto &b) {
+        return std::abs(a.first - time) < std::abs(b.first - time);
+      });
+    const std::string number = chosen->second.substr(chosen->second.rfind('_') + 1, 5);
+    SampleSnapshot    s{sample_snapshot_path((fs::path(run_dir) / "fields").string(), std::stoul(number)),
+                     chosen->first, ""};
+    if (!fs::is_regular_file(s.path))
+      throw InputError("tribo sample " + run_dir + ": no sample next to the snapshot at t = " +
+                       to_text(chosen->first) + " s (" + s.path + " not found: only shear runs with a rigid "
+                       "upper wall write them)");
+    const RunRecord run = read_run_record(run_dir);
+    if (run.length <= 0)
+      throw InputError("tribo sample " + run_dir + ": cannot read the run's Shear cell/Length from " +
+                       (fs::path(run_dir) / "parameters.prm").string());
+    read_sample(s.path, run.length);
+    std::ifstream      file(s.path);
+    std::ostringstream text;
+    text << file.rdbuf();
+    s.text = text.str();
+    return s;
   }
 } // namespace tribo::app

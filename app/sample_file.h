@@ -42,4 +42,22 @@ namespace tribo::app
   /// The discs of sample file @p path for a cell of period @p length (m); throws
   /// InputError naming the file, line and column (see the file comment).
   std::vector<SampleDisc> read_sample(const std::string &path, double length);
+
+  /// The sample file written next to field snapshot @p index in @p fields_dir:
+  /// FIELDS_DIR/sample_NNNNN.csv, numbered like discs_NNNNN.vtu.
+  std::string sample_snapshot_path(const std::string &fields_dir, unsigned int index);
+
+  /// A snapshot of a run as a sample file (`tribo sample`).
+  struct SampleSnapshot
+  {
+    std::string path; ///< RUN/fields/sample_NNNNN.csv
+    double      time; ///< s, the snapshot's time in fields/discs.pvd
+    std::string text; ///< the file, checked with read_sample() against the run's Length
+  };
+
+  /// The snapshot of run directory @p run_dir whose time is nearest @p time (s), or the
+  /// last one for a NaN @p time; InputError naming the directory when it has no
+  /// snapshot index, no sample next to the snapshot (a scene without one), or the run's
+  /// parameters.prm cannot be read.
+  SampleSnapshot sample_snapshot(const std::string &run_dir, double time);
 } // namespace tribo::app

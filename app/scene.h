@@ -45,9 +45,10 @@ namespace tribo::app
     virtual void summarize(const dem::ParticleSystem &, const TimeSeries &, JsonObject &) {}
     /// Extra tables, written as NAME.csv and as the HDF5 group NAME (after summarize()).
     virtual std::map<std::string, TimeSeries> tables() const { return {}; }
-    /// The final state as a sample file (app/sample_file.h), written as sample_final.csv;
-    /// "" when the scene has none.
-    virtual std::string final_sample(const dem::ParticleSystem &) const { return ""; }
+    /// The state as a sample file (app/sample_file.h), written with every snapshot as
+    /// fields/sample_NNNNN.csv and at the end as sample_final.csv; "" when the scene has
+    /// none.
+    virtual std::string sample(const dem::ParticleSystem &) const { return ""; }
     /// Checkpoint: the state the scene carries between steps (counters, phase, samples,
     /// a deformable body), after build() and attach() have rebuilt the rest.
     virtual void save(CheckpointOut &) const {}

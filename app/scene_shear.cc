@@ -51,6 +51,7 @@ namespace tribo::app
       {
         const auto &k = prm.shear;
         s.period      = k.length;
+        steps_done    = std::lround(prm.start_time / prm.time_step);
         if (!k.sample.empty())
           build_from_sample(s);
         else
@@ -96,7 +97,7 @@ namespace tribo::app
 
       /// The grains and both walls; none with a deformable upper body (a sample holds
       /// discs only).
-      std::string final_sample(const dem::ParticleSystem &s) const override
+      std::string sample(const dem::ParticleSystem &s) const override
       {
         return body ? "" : sample_text(s, lower, upper);
       }

@@ -1,5 +1,6 @@
 #include "app/study.h"
 
+#include "app/case_parameters.h"
 #include "app/run.h"
 #include "core/errors.h"
 #include "core/output.h"
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -85,6 +87,62 @@ namespace tribo::app
       return "\"" + q + "\"";
     }
 
+    /// The entry of an override "Subsection/Entry=value".
+    std::string entry_of(const std::string &assignment) { return trim(assignment.substr(0, assignment.find('='))); }
+
+    /// True for the entries that act only from Shear cell/Shear start on, or not on the
+    /// bodies at all: the cases of a study that differ only in these (and in the study's
+    /// Shear-phase entries) share one compaction.
+    bool acts_only_after_shear_start(const std::string &entry)
+    {
+      return entry == "Simulation/End time" || entry == "Shear cell/Sliding velocity" ||
+             entry == "Shear cell/Profile samples" || entry == "Shear cell/Layer thickness" ||
+             entry.rfind("Output/", 0) == 0;
+    }
+
+    /// The compaction a shear case of @p base with @p overrides starts from, as the
+    /// overrides of a compaction-only run (its entries that act before Shear start, End
+    /// time = Shear start); "" when the case cannot share one (another scene, a deformable
+    /// upper body, a sample state already given, no compaction or no shearing).
+    std::vector<std::string> preparation_of(const fs::path &base, const std::vector<std::string> &overrides,
+                                            const std::vector<std::string> &shear_phase)
+    {
+      dealii::ParameterHandler prm;
+      declare_case_parameters(prm);
+      ParameterFile file(prm);
+      file.parse(base.string());
+      for (const auto &o : overrides)
+        file.set(o);
+      if (file.get("Simulation/Scene") != "shear" || file.get("Shear cell/Upper body model") != "rigid" ||
+          !file.get("Shear cell/Initial state").empty() || file.get_double("Shear cell/Shear start") <= 0 ||
+          file.get_double("Shear cell/Shear start") >= file.get_double("Simulation/End time"))
+        return {};
+      std::vector<std::string> preparation;
+      for (const auto &o : overrides)
+        if (!acts_only_after_shear_start(entry_of(o)) &&
+            std::find(shear_phase.begin(), shear_phase.end(), entry_of(o)) == shear_phase.end())
+          preparation.push_back(o);
+      preparation.push_back("Simulation/End time=" + file.get("Shear cell/Shear start"));
+      preparation.push_back("Output/Plots=false");
+      return preparation;
+    }
+
+    /// Number @p v with @p digits significant digits (v itself if it is not a number).
+    std::string significant(const std::string &v, int digits)
+    {
+      try
+        {
+          std::ostringstream os;
+          os.precision(digits);
+          os << std::stod(v);
+          return os.str();
+        }
+      catch (const std::exception &)
+        {
+          return v;
+        }
+    }
+
     /// A value of summary.json "results" (or the top level), or "" if absent/null.
     std::string value_of(const boost::property_tree::ptree &tree, const std::string &key)
     {
@@ -110,6 +168,15 @@ namespace tribo::app
                       "'combinations': every combination of the Parameters lists; 'tradeoff': the "
                       "Reference case, then each Parameters list as a ladder varied alone from the base "
                       "case, with cost and error against the Reference (scripts/tradeoff.py).");
+    prm.declare_entry("Shear-phase entries", "", dealii::Patterns::Anything(),
+                      "Entries (\"Subsection/Entry; ...\") the study applies from Shear start on only: the "
+                      "shared compaction runs with the base case's values of them (e.g. Contact "
+                      "law/Cohesion for a study of cohesion in shear from one compacted sample).");
+    prm.declare_entry("Share compaction", "true", dealii::Patterns::Bool(),
+                      "Shear cases that differ only in entries acting after Shear start (End time, "
+                      "Sliding velocity, Profile samples, Layer thickness, Output/*, the Shear-phase "
+                      "entries) run their compaction once and shear from its state (Shear cell/Initial "
+                      "state, docs/outputs.md 'Studies').");
     prm.declare_entry("Reference", "", dealii::Patterns::Anything(),
                       "Design = tradeoff: the finest setting, \"Subsection/Entry = value; ...\" (each "
                       "entry one of the Parameters).");
@@ -195,15 +262,72 @@ namespace tribo::app
       }
 
     // Check every combination before running any (bad input fails fast, exit 2).
+    const auto check_case = [&](const std::vector<std::string> &overrides) {
+      RunOptions check;
+      check.case_file  = base.string();
+      check.overrides  = overrides;
+      check.check_only = true;
+      check.quiet      = true;
+      run_case(check);
+    };
     for (const auto &c : cases)
+      check_case(c);
+
+    // One compaction per distinct preparation, when cases share one (a tradeoff's ladders
+    // judge the whole run, compaction included: they never share).
+    const std::vector<std::string> shear_phase = split(file.get("Study/Shear-phase entries"), ';');
+    for (const auto &e : shear_phase)
       {
-        RunOptions check;
-        check.case_file  = base.string();
-        check.overrides  = c;
-        check.check_only = true;
-        check.quiet      = true;
-        run_case(check);
+        dealii::ParameterHandler check;
+        declare_case_parameters(check);
+        ParameterFile entries(check);
+        try
+          {
+            entries.get(e);
+          }
+        catch (const std::exception &)
+          {
+            throw InputError(file.where("Study/Shear-phase entries") + ": '" + e +
+                             "' is not an entry of a case (expected \"Subsection/Entry; ...\")");
+          }
       }
+    std::vector<std::vector<std::string>> preparations; ///< distinct, as overrides
+    std::vector<int>                      preparation_of_case(cases.size(), -1);
+    std::string                           sharing_note;
+    if (!tradeoff && file.get_bool("Study/Share compaction"))
+      {
+        std::map<std::vector<std::string>, int> index;
+        bool                                    all = true;
+        for (std::size_t i = 0; i < cases.size() && all; ++i)
+          {
+            const auto prep = preparation_of(base, cases[i], shear_phase);
+            all             = !prep.empty();
+            if (all && !index.count(prep))
+              {
+                index[prep] = int(preparations.size());
+                preparations.push_back(prep);
+              }
+            preparation_of_case[i] = all ? index[prep] : -1;
+          }
+        if (!all || preparations.size() == cases.size())
+          {
+            sharing_note = !all ? "no shared compaction: not every case is a rigid-wall shear case with a "
+                                  "compaction (0 < Shear start < End time) and no initial state"
+                                : "no shared compaction: every case compacts differently";
+            preparations.clear();
+            std::fill(preparation_of_case.begin(), preparation_of_case.end(), -1);
+          }
+        else
+          sharing_note = std::to_string(cases.size()) + " cases shear from " + std::to_string(preparations.size()) +
+                         " shared compaction" + (preparations.size() > 1 ? "s" : "") +
+                         " (preparation_NNN/, Shear cell/Initial state): they differ only in entries that act "
+                         "after Shear start" + (shear_phase.empty() ? "" : " or in the Shear-phase entries");
+      }
+    else
+      sharing_note = tradeoff ? "no shared compaction: a tradeoff measures whole runs"
+                              : "no shared compaction: Study/Share compaction = false";
+    for (const auto &prep : preparations)
+      check_case(prep);
 
     const fs::path dir = o.output_dir.empty() ? fs::path("output") / fs::path(o.study_file).stem()
                                               : fs::path(o.output_dir);
@@ -213,72 +337,94 @@ namespace tribo::app
       fs::create_directories(dir);
     MPI_Barrier(MPI_COMM_WORLD);
 
-    const auto case_dir = [&](std::size_t i) {
-      char name[32];
-      std::snprintf(name, sizeof name, "case_%03zu", i);
+    const auto numbered_dir = [&](const char *stem, std::size_t i) {
+      char name[48];
+      std::snprintf(name, sizeof name, "%s_%03zu", stem, i);
       return dir / name;
     };
-    const auto overrides_text = [&](std::size_t i) {
+    const auto case_dir = [&](std::size_t i) { return numbered_dir("case", i); };
+    // A case sharing a compaction starts from its state.
+    for (std::size_t i = 0; i < cases.size(); ++i)
+      if (preparation_of_case[i] >= 0)
+        cases[i].push_back("Shear cell/Initial state=" +
+                           fs::absolute(numbered_dir("preparation", preparation_of_case[i])).string());
+    const auto overrides_text = [&](const std::vector<std::string> &overrides) {
       std::string s = "# tribo study: base case " + base.string() + "\n";
-      for (const auto &a : cases[i])
+      for (const auto &a : overrides)
         s += a + "\n";
       return s;
     };
 
-    // One case per rank at a time: rank r takes cases r, r + size, ...
+    // Run one case (or preparation) into @p cd, or skip it when complete with the same
+    // overrides, or resume it from its checkpoint; false when interrupted by a signal.
+    const auto run_in = [&](const fs::path &cd, const std::vector<std::string> &overrides,
+                            const std::string &label) {
+      const std::string text = overrides_text(overrides);
+      if (fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == text && run_status(cd.string()) == "complete")
+        {
+          if (!o.quiet)
+            std::cout << label << ": complete, skipped" << std::endl;
+          return true;
+        }
+      // A run of this parameter set that stopped with a checkpoint goes on from it.
+      const bool resume = fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == text &&
+                          fs::exists(cd / "checkpoint.bin") && run_status(cd.string()) != "failed";
+      fs::create_directories(cd);
+      atomic_write((cd / "study.prm").string(), text);
+      RunOptions run;
+      run.case_file = base.string();
+      run.overrides = overrides;
+      (resume ? run.resume_dir : run.output_dir) = cd.string();
+      run.quiet = true;
+      if (!o.quiet)
+        std::cout << label << " (rank " << rank << "): " << (resume ? "resuming" : "running") << std::endl;
+      try
+        {
+          run_case(run);
+        }
+      catch (const std::exception &e)
+        {
+          // Recorded for the table; the other cases go on.
+          JsonObject failed;
+          failed.set("status", "failed");
+          failed.set("error", e.what());
+          atomic_write((cd / "summary.json").string(), failed.to_string());
+        }
+      if (!o.quiet)
+        std::cout << label << ": " << run_status(cd.string()) << std::endl;
+      if (stop_requested())
+        {
+          // Ctrl-C or SIGTERM: the running case was closed as interrupted; stop here,
+          // a rerun resumes from it.
+          std::cout << "study interrupted by signal " << stop_requested() << std::endl;
+          return false;
+        }
+      return true;
+    };
+
+    if (rank == 0 && !o.quiet)
+      std::cout << "study: " << sharing_note << std::endl;
+    // The shared compactions first, one per rank at a time, then the cases: rank r takes
+    // r, r + size, ...
+    for (std::size_t i = rank; i < preparations.size(); i += size)
+      if (!run_in(numbered_dir("preparation", i), preparations[i], "preparation " + std::to_string(i)))
+        return 128 + stop_requested();
+    MPI_Barrier(MPI_COMM_WORLD);
     for (std::size_t i = rank; i < cases.size(); i += size)
-      {
-        const fs::path cd = case_dir(i);
-        if (fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == overrides_text(i) &&
-            run_status(cd.string()) == "complete")
-          {
-            if (!o.quiet)
-              std::cout << "case " << i << ": complete, skipped" << std::endl;
-            continue;
-          }
-        // A case of this parameter set that stopped with a checkpoint goes on from it.
-        const bool resume = fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == overrides_text(i) &&
-                            fs::exists(cd / "checkpoint.bin") && run_status(cd.string()) != "failed";
-        fs::create_directories(cd);
-        atomic_write((cd / "study.prm").string(), overrides_text(i));
-        RunOptions run;
-        run.case_file  = base.string();
-        run.overrides  = cases[i];
-        (resume ? run.resume_dir : run.output_dir) = cd.string();
-        run.quiet      = true;
-        if (!o.quiet)
-          std::cout << "case " << i << " (rank " << rank << "): " << (resume ? "resuming" : "running") << std::endl;
-        try
-          {
-            run_case(run);
-          }
-        catch (const std::exception &e)
-          {
-            // Recorded for the table; the other cases go on.
-            JsonObject failed;
-            failed.set("status", "failed");
-            failed.set("error", e.what());
-            atomic_write((cd / "summary.json").string(), failed.to_string());
-          }
-        if (!o.quiet)
-          std::cout << "case " << i << ": " << run_status(cd.string()) << std::endl;
-        if (stop_requested())
-          {
-            // Ctrl-C or SIGTERM: the running case was closed as interrupted; stop here,
-            // a rerun resumes from it.
-            std::cout << "study interrupted by signal " << stop_requested() << std::endl;
-            return 128 + stop_requested();
-          }
-      }
+      if (!run_in(case_dir(i), cases[i], "case " + std::to_string(i)))
+        return 128 + stop_requested();
     MPI_Barrier(MPI_COMM_WORLD);
     if (rank != 0)
       return exit_ok;
 
-    // The summary table, from every case's summary.json.
+    // The summary table, from every case's summary.json: a time-averaged figure with its
+    // batch-means standard error (the next key), written "mean +/- stderr" in the .md.
     const std::vector<std::string> keys = {
-      "status", "mu_mean", "mu_std", "power_balance_ratio", "power_lower_wall_mean",
-      "power_dissipated_mean", "normal_force_mean", "sigma_xx_mean", "sigma_yy_mean",
-      "sigma_xy_mean", "inertial_number", "cohesion_number", "steady_state_reached", "wall_time", "error"};
+      "status", "mu_mean", "mu_stderr", "mu_std", "power_balance_ratio", "power_balance_ratio_stderr",
+      "power_lower_wall_mean", "power_dissipated_mean", "normal_force_mean", "normal_force_stderr",
+      "sigma_xx_mean", "sigma_xx_stderr", "sigma_yy_mean", "sigma_yy_stderr", "sigma_xy_mean",
+      "sigma_xy_stderr", "inertial_number", "cohesion_number", "steady_state_reached", "wall_time", "error"};
+    const auto is_stderr = [](const std::string &k) { return k.size() > 7 && k.substr(k.size() - 7) == "_stderr"; };
     std::ostringstream csv, md;
     csv << "case";
     md << "| case";
@@ -287,14 +433,19 @@ namespace tribo::app
         csv << ",\"" << h << "\"";
         md << " | " << h;
       }
+    unsigned int md_columns = 0;
     for (const auto &k : keys)
       {
         csv << "," << k;
-        md << " | " << k;
+        if (!is_stderr(k))
+          {
+            md << " | " << k;
+            ++md_columns;
+          }
       }
-    csv << ",directory\n";
+    csv << ",preparation,directory\n";
     md << " |\n|---";
-    for (std::size_t c = 0; c < headers.size() + keys.size(); ++c)
+    for (std::size_t c = 0; c < headers.size() + md_columns; ++c)
       md << "|---";
     md << "|\n";
     unsigned int n_failed = 0;
@@ -318,16 +469,23 @@ namespace tribo::app
             csv << "," << csv_field(value);
             md << " | " << value;
           }
-        for (const auto &k : keys)
+        for (std::size_t k = 0; k < keys.size(); ++k)
           {
-            const std::string v = value_of(tree, k);
-            md << " | " << v;
+            const std::string v = value_of(tree, keys[k]);
             csv << "," << csv_field(v);
+            if (is_stderr(keys[k]))
+              continue;
+            const std::string se = k + 1 < keys.size() && is_stderr(keys[k + 1]) ? value_of(tree, keys[k + 1]) : "";
+            md << " | " << (se.empty() || v.empty() ? v : significant(v, 5) + " +/- " + significant(se, 2));
           }
-        csv << "," << case_dir(i).filename().string() << "\n";
+        csv << ","
+            << (preparation_of_case[i] >= 0 ? numbered_dir("preparation", preparation_of_case[i]).filename().string()
+                                            : "")
+            << "," << case_dir(i).filename().string() << "\n";
         md << " |\n";
       }
     atomic_write((dir / "study_summary.csv").string(), csv.str());
+    md << "\nCompaction: " << sharing_note << ".\n";
     atomic_write((dir / "study_summary.md").string(), md.str());
 
     // Overlay plots of the profiles (a convenience: a failure is a warning).

@@ -18,6 +18,12 @@
 /// of different parameter sets. A failed case is a row with its status and error;
 /// the others go on. OUTPUT/study_summary.csv and .md hold one row per case.
 ///
+/// Shear cases that differ only in entries acting after Shear start (End time, Sliding
+/// velocity, Profile samples, Layer thickness, Output/*, and `set Shear-phase entries =
+/// ...`) share their compaction: each distinct one runs once as OUTPUT/preparation_NNN/
+/// (End time = Shear start) and the cases shear from its state (Shear cell/Initial
+/// state); `set Share compaction = false` turns this off (docs/outputs.md, "Studies").
+///
 /// With `set Design = tradeoff` the Parameters lists are ladders of the knobs that cost
 /// time (time step, tolerance, mesh, model, ...): case 0 is the Reference (the finest
 /// setting, `set Reference = Solver/Tolerance = 1e-5; ...`), then each ladder is run

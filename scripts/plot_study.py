@@ -18,10 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-FIXED = {"case", "status", "mu_mean", "mu_std", "power_balance_ratio", "power_lower_wall_mean",
-         "power_dissipated_mean", "normal_force_mean", "sigma_xx_mean", "sigma_yy_mean",
-         "sigma_xy_mean", "inertial_number", "cohesion_number", "steady_state_reached",
-         "wall_time", "error", "directory"}
+
 
 
 def save(fig, path):
@@ -34,7 +31,9 @@ def save(fig, path):
 def main(directory):
     with open(os.path.join(directory, "study_summary.csv")) as f:
         rows = list(csv.DictReader(f))
-    varied = [k for k in rows[0].keys() if k not in FIXED] if rows else []
+    # The varied entries: the columns between "case" and "status".
+    names = list(rows[0].keys()) if rows else []
+    varied = names[1:names.index("status")] if "status" in names else []
     label = lambda r: ", ".join(f"{k.split('/')[-1]}={r[k]}" for k in varied) or r["case"]
 
     fig, axes = plt.subplots(1, 3, figsize=(11, 4), sharey=True)

@@ -4,22 +4,29 @@
     /usr/bin/python3 scripts/tradeoff.py STUDY_OUTPUT_DIR
 
 Reads study_summary.csv (case 0 is the reference, each other row one rung of one
-ladder, columns "knob" and "value") and each case's summary.json, statistics.csv and
-profiles.csv. For every complete case:
+ladder, columns "knob" and "value") and each case's summary.json and profiles.csv.
+For every complete case:
 
 - cost: wall time per simulated time, s per simulated microsecond (summary.json
   wall_time / simulated_time), and its ratio to the reference's;
-- mu_error: |mu - mu_ref| / mu_ref over the steady state;
+- mu_mean +/- mu_stderr (summary.json results.mu_mean, results.mu_stderr: the
+  batch-means standard error) and mu_error = |mu - mu_ref| / mu_ref;
+- sigma_yy_mean, sigma_xy_mean +/- their summary.json *_stderr (Pa);
+- power_balance_ratio +/- power_balance_ratio_stderr, balance_residual =
+  |1 - ratio| of the case itself and balance_residual_over_se = residual / stderr;
+- for mu, sigma_yy, sigma_xy and the power balance ratio, X_diff_over_se =
+  (X - X_ref) / sqrt(se^2 + se_ref^2): the difference against the reference over the
+  combined standard error of the two means (power_balance_diff_over_se for the
+  ratio); |X_diff_over_se| > 2 is marked "significant" in tradeoff.md, below it the
+  difference is within the statistical noise of two runs;
 - vx_l2, sigma_yy_l2, sigma_xy_l2: relative L2 differences of the profiles,
   ||p - p_ref|| / ||p_ref||, with p interpolated at the reference's layer heights y/h;
-- balance_residual: |1 - P_dissipated / P_lower_wall| of the case itself;
-- mu_scatter: the reference's standard error of mean mu by batch means (20 batches
-  over the steady-state rows of statistics.csv): differences below about twice it are
-  noise, not error.
+- steady_state_reached as summary.json gives it.
 
 Writes tradeoff.csv, tradeoff.md and tradeoff.png (cost against the mu error and
-against the largest profile error, Pareto fronts drawn); exits 1 if the reference is
-not complete.
+against the largest profile error, Pareto fronts drawn; on the mu panel, rungs whose
+mu is within 2 combined standard errors of the reference's are open circles); exits 1
+if the reference is not complete.
 
 A study of the collision scene (summary.json "scene" = collision) is measured on what
 that scene gives instead: cost = wall time of the collision, s; restitution_error =
@@ -40,6 +47,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 PROFILES = ("vx", "sigma_yy", "sigma_xy")
+COMPARED_STRESSES = ("sigma_yy", "sigma_xy")  # summary.json *_mean, *_stderr
 
 
 def read_profiles(path):
@@ -56,14 +64,24 @@ def relative_l2(p, ref, q):
     return float(np.linalg.norm(values - ref[q]) / norm) if norm > 0 else float("nan")
 
 
-def batch_standard_error(stats_path, t_start, batches=20):
-    """Standard error of the mean of mu over t >= t_start, by batch means."""
-    with open(stats_path) as f:
-        mu = np.array([float(r["mu"]) for r in csv.DictReader(f) if float(r["time"]) >= t_start])
-    if mu.size < 2 * batches:
-        return float("nan")
-    means = np.array([b.mean() for b in np.array_split(mu, batches)])
-    return float(means.std(ddof=1) / math.sqrt(batches))
+def number(x):
+    """@p x as a float if it is a finite number (summary.json writes NaN as null), else nan."""
+    ok = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    return float(x) if ok else float("nan")
+
+
+def diff_over_se(x, se, x_ref, se_ref):
+    """(x - x_ref) / sqrt(se^2 + se_ref^2): a difference in combined standard errors
+    (0 for identical means, nan if a standard error is missing)."""
+    x, se, x_ref, se_ref = number(x), number(se), number(x_ref), number(se_ref)
+    combined = math.sqrt(se * se + se_ref * se_ref)
+    if x == x_ref:
+        return 0.0
+    return (x - x_ref) / combined if combined > 0 else float("nan")
+
+
+def significant(z):
+    return math.isfinite(z) and abs(z) > 2
 
 
 def pareto(points):
@@ -80,6 +98,21 @@ def pareto(points):
 
 def fmt(v, digits=3):
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{digits}g}"
+
+
+def fmt_se(mean, se, digits=4, scale=1.0):
+    """"mean +/- stderr" of a summary.json figure (divided by @p scale); "-" without a mean."""
+    mean, se = number(mean), number(se)
+    if not math.isfinite(mean):
+        return "-"
+    return f"{mean / scale:.{digits}g} +/- " + (f"{se / scale:.2g}" if math.isfinite(se) else "-")
+
+
+def fmt_z(z):
+    """A difference in combined standard errors, marked "significant" beyond 2."""
+    if not math.isfinite(z):
+        return "-"
+    return f"{z:+.1f}" + (" **significant**" if significant(z) else "")
 
 
 def tabulate(cases, measure):
@@ -99,11 +132,12 @@ def tabulate(cases, measure):
     return table
 
 
-def write_outputs(directory, table, columns, md, panels, ref_cost, cost_label, hlines=()):
+def write_outputs(directory, table, columns, md, panels, ref_cost, cost_label, hlines=(), hollow=None):
     """tradeoff.csv (@p columns of @p table), tradeoff.md (the lines @p md) and tradeoff.png,
     each written atomically. @p panels: (row key or function of a row, y label) per subplot;
     each plots cost against that error for every rung, with the Pareto front and the
-    reference's cost; @p hlines: (panel index, y, label) reference lines."""
+    reference's cost; @p hlines: (panel index, y, label) reference lines; @p hollow:
+    (panel index, function of a row, legend label): rows it is true for drawn open there."""
     tmp = os.path.join(directory, "tradeoff.csv.tmp")
     with open(tmp, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
@@ -119,12 +153,13 @@ def write_outputs(directory, table, columns, md, panels, ref_cost, cost_label, h
     knobs = sorted({t["knob"] for t in rungs})
     colours = {k: f"C{i}" for i, k in enumerate(knobs)}
     fig, axes = plt.subplots(1, len(panels), figsize=(11, 4.5))
-    for ax, (key, label) in zip(axes, panels):
+    for i, (ax, (key, label)) in enumerate(zip(axes, panels)):
         error = key if callable(key) else (lambda t, key=key: t[key])
         pts = [(t["cost"], error(t), t) for t in rungs]
         pts = [(c, e, t) for c, e, t in pts if math.isfinite(c) and math.isfinite(e) and e > 0]
         for c, e, t in pts:
-            ax.plot(c, e, "o", color=colours[t["knob"]])
+            open_marker = hollow is not None and hollow[0] == i and hollow[1](t)
+            ax.plot(c, e, "o", color=colours[t["knob"]], mfc="none" if open_marker else colours[t["knob"]])
             ax.annotate(t["value"], (c, e), fontsize=7, xytext=(3, 3), textcoords="offset points")
         front = pareto([(c, e) for c, e, _ in pts])
         ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, label="Pareto front")
@@ -137,6 +172,9 @@ def write_outputs(directory, table, columns, md, panels, ref_cost, cost_label, h
         axes[i].axhline(y, color="grey", lw=0.8, ls=":", label=label)
     for k in knobs:
         axes[0].plot([], [], "o", color=colours[k], label=k)
+    if hollow is not None:
+        axes[hollow[0]].plot([], [], "o", color="k", mfc="none", label=hollow[2])
+        axes[hollow[0]].legend(fontsize=7)
     axes[0].legend(fontsize=7)
     fig.tight_layout()
     tmp = os.path.join(directory, "tradeoff.tmp.png")
@@ -168,8 +206,7 @@ def main(directory):
     ref_results = ref["summary"]["results"]
     ref_profiles = read_profiles(os.path.join(ref["dir"], "profiles.csv"))
     mu_ref = ref_results.get("mu_mean")
-    scatter = batch_standard_error(os.path.join(ref["dir"], "statistics.csv"),
-                                   ref_results.get("steady_state_start") or 0.0)
+    se_ref = number(ref_results.get("mu_stderr"))
 
     def measure(c, out):
         s = c["summary"]
@@ -177,13 +214,27 @@ def main(directory):
         out["cost"] = s["wall_time"] / (s["simulated_time"] * 1e6)
         mu = res.get("mu_mean")
         out["mu_mean"] = mu
+        out["mu_stderr"] = number(res.get("mu_stderr"))
         out["mu_error"] = abs(mu - mu_ref) / abs(mu_ref) if mu is not None and mu_ref else float("nan")
+        out["mu_diff_over_se"] = diff_over_se(mu, res.get("mu_stderr"), mu_ref, se_ref)
+        for q in COMPARED_STRESSES:
+            out[q + "_mean"] = number(res.get(q + "_mean"))
+            out[q + "_stderr"] = number(res.get(q + "_stderr"))
+            out[q + "_diff_over_se"] = diff_over_se(res.get(q + "_mean"), res.get(q + "_stderr"),
+                                                    ref_results.get(q + "_mean"), ref_results.get(q + "_stderr"))
         prof = read_profiles(os.path.join(c["dir"], "profiles.csv"))
         for q in PROFILES:
             out[q + "_l2"] = (relative_l2(prof, ref_profiles, q)
                               if prof is not None and ref_profiles is not None else float("nan"))
         ratio = res.get("power_balance_ratio")
+        ratio_se = number(res.get("power_balance_ratio_stderr"))
+        out["power_balance_ratio"] = number(ratio)
+        out["power_balance_ratio_stderr"] = ratio_se
         out["balance_residual"] = abs(1 - ratio) if ratio is not None else float("nan")
+        out["balance_residual_over_se"] = (out["balance_residual"] / ratio_se
+                                           if math.isfinite(ratio_se) and ratio_se > 0 else float("nan"))
+        out["power_balance_diff_over_se"] = diff_over_se(ratio, ratio_se, ref_results.get("power_balance_ratio"),
+                                                         ref_results.get("power_balance_ratio_stderr"))
         out["nlgs_sweeps_per_step"] = s.get("nlgs_iterations_mean")
         out["steady_state_reached"] = res.get("steady_state_reached")
 
@@ -192,26 +243,50 @@ def main(directory):
 
     columns = ["knob", "value", "status", "cost", "cost_ratio", "mu_mean", "mu_error", "vx_l2",
                "sigma_yy_l2", "sigma_xy_l2", "balance_residual", "nlgs_sweeps_per_step",
-               "steady_state_reached", "directory"]
-    md = [f"Reference: {table[0]['value']}; mean mu {fmt(mu_ref, 4)}, its standard error "
-          f"(batch means) {fmt(scatter, 2)}: mu errors below about {fmt(2 * scatter / mu_ref if mu_ref else float('nan'), 2)} "
-          "are within the noise.", "",
-          "| knob | value | cost (s per simulated us) | cost / reference | mean mu | mu error | vx L2 | "
-          "sigma_yy L2 | sigma_xy L2 | balance residual | sweeps/step | status |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+               "steady_state_reached", "directory",
+               "mu_stderr", "mu_diff_over_se"]
+    for q in COMPARED_STRESSES:
+        columns += [q + "_mean", q + "_stderr", q + "_diff_over_se"]
+    columns += ["power_balance_ratio", "power_balance_ratio_stderr", "power_balance_diff_over_se",
+                "balance_residual_over_se"]
+    # Two runs as noisy as the reference: 2 combined standard errors, relative to mu_ref.
+    noise = 2 * math.sqrt(2) * se_ref / abs(mu_ref) if mu_ref and math.isfinite(se_ref) else float("nan")
+    md = [f"Reference: {table[0]['value']}; mean mu {fmt(mu_ref, 4)}, its standard error (batch means) "
+          f"{fmt(se_ref, 2)} (summary.json mu_stderr). Each figure is mean +/- standard error; "
+          "\"diff / se\" is (rung - reference) / sqrt(se_rung^2 + se_ref^2), **significant** when "
+          f"beyond 2 (for a rung as noisy as the reference: mu errors above about {fmt(noise, 2)}).", ""]
+    if ref_results.get("steady_state_reached") is not True:
+        md += ["**The reference did not reach a steady state** (steady_state_reached false): its means are "
+               "over the fallback window; lengthen its run before trusting these differences.", ""]
+    md += ["| knob | value | cost (s per simulated us) | cost / reference | mean mu | mu error | mu diff / se | "
+           "sigma_yy (MPa) | sigma_yy diff / se | sigma_xy (MPa) | sigma_xy diff / se | power balance ratio | "
+           "balance diff / se | balance residual | vx L2 | sigma_yy L2 | sigma_xy L2 | sweeps/step | steady | "
+           "status |",
+           "|" + "---|" * 20]
     for t in table:
+        steady = t.get("steady_state_reached")
         md.append("| " + " | ".join([t["knob"], t["value"], fmt(t.get("cost")), fmt(t.get("cost_ratio")),
-                                     fmt(t.get("mu_mean"), 4), fmt(t.get("mu_error"), 2), fmt(t.get("vx_l2"), 2),
+                                     fmt_se(t.get("mu_mean"), t.get("mu_stderr")), fmt(t.get("mu_error"), 2),
+                                     fmt_z(t.get("mu_diff_over_se", float("nan"))),
+                                     fmt_se(t.get("sigma_yy_mean"), t.get("sigma_yy_stderr"), 4, 1e6),
+                                     fmt_z(t.get("sigma_yy_diff_over_se", float("nan"))),
+                                     fmt_se(t.get("sigma_xy_mean"), t.get("sigma_xy_stderr"), 4, 1e6),
+                                     fmt_z(t.get("sigma_xy_diff_over_se", float("nan"))),
+                                     fmt_se(t.get("power_balance_ratio"), t.get("power_balance_ratio_stderr"), 3),
+                                     fmt_z(t.get("power_balance_diff_over_se", float("nan"))),
+                                     fmt(t.get("balance_residual"), 2), fmt(t.get("vx_l2"), 2),
                                      fmt(t.get("sigma_yy_l2"), 2), fmt(t.get("sigma_xy_l2"), 2),
-                                     fmt(t.get("balance_residual"), 2), fmt(t.get("nlgs_sweeps_per_step"), 4),
+                                     fmt(t.get("nlgs_sweeps_per_step"), 4),
+                                     "-" if steady is None else ("yes" if steady else "**no**"),
                                      t["status"]]) + " |")
-    hlines = ([(0, 2 * scatter / mu_ref, "2 x standard error of mu_ref")]
-              if math.isfinite(scatter) and mu_ref else [])
+    hlines = ([(0, noise, "2 combined stderr (rung as noisy as the reference)")] if math.isfinite(noise) else [])
     write_outputs(directory, table, columns, md,
                   [("mu_error", "|mu - mu_ref| / mu_ref"),
                    (lambda t: max(t[q + "_l2"] for q in PROFILES),
                     "largest profile L2 error (vx, sigma_yy, sigma_xy)")],
-                  ref_cost, "cost: wall s per simulated us", hlines)
+                  ref_cost, "cost: wall s per simulated us", hlines,
+                  (0, lambda t: math.isfinite(t.get("mu_diff_over_se", float("nan"))) and abs(t["mu_diff_over_se"]) <= 2,
+                   "within 2 combined stderr of mu_ref"))
 
 
 def collision_tradeoff(directory, cases):

@@ -70,16 +70,23 @@ def table(directory):
         return [{k: r[k] for k in PHYSICS} for r in csv.DictReader(f)]
 
 
-class Study(unittest.TestCase):
+class WithBaseCase(unittest.TestCase):
+    """A temporary directory holding base.prm (BASE)."""
+
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
         self.dir = self.tmp.name
         with open(os.path.join(self.dir, "base.prm"), "w") as f:
             f.write(BASE)
-        self.write_study()
 
     def tearDown(self):
         self.tmp.cleanup()
+
+
+class Study(WithBaseCase):
+    def setUp(self):
+        super().setUp()
+        self.write_study()
 
     def write_study(self, extra=""):
         with open(os.path.join(self.dir, "study.prm"), "w") as f:
@@ -159,16 +166,102 @@ class Study(unittest.TestCase):
         self.assertFalse(os.path.exists(out))
 
 
-class Tradeoff(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
-        with open(os.path.join(self.dir, "base.prm"), "w") as f:
-            f.write(BASE)
+SHARED = """
+subsection Study
+  set Base case = base.prm
+  set Parameters = Shear cell/Sliding velocity = 2, 5; Contact law/Cohesion = 0, 120
+  set Fixed = Contact law/Cohesion range = 2.4e-8
+  set Shear-phase entries = {shear_phase}
+end
+"""
 
-    def tearDown(self):
-        self.tmp.cleanup()
 
+class SharedCompaction(WithBaseCase):
+    """Cases that differ only in what acts after Shear start (and the study's Shear-phase
+    entries) shear from one compaction, run once, and give exactly what each gives run
+    alone from that state (Shear cell/Initial state)."""
+
+    def study(self, shear_phase):
+        with open(os.path.join(self.dir, "study.prm"), "w") as f:
+            f.write(SHARED.format(shear_phase=shear_phase))
+        out = os.path.join(self.dir, "out")
+        p = subprocess.run([TRIBO, "study", os.path.join(self.dir, "study.prm"), "--output", out],
+                           capture_output=True, text=True, timeout=300)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        return p.stdout, out
+
+    def test_one_compaction_and_each_case_equals_its_run_from_the_state(self):
+        log, out = self.study("Contact law/Cohesion")
+        note = "4 cases shear from 1 shared compaction"
+        self.assertIn(note, log)
+        with open(os.path.join(out, "study_summary.md")) as f:
+            self.assertIn("Compaction: " + note, f.read())
+        self.assertEqual(sorted(d for d in os.listdir(out) if d.startswith("preparation")), ["preparation_000"])
+        prep = os.path.join(out, "preparation_000")
+        with open(os.path.join(prep, "summary.json")) as f:
+            p = json.load(f)
+        # The compaction runs to Shear start (6e-7 s: 300 steps of 2e-9 s) with the base
+        # case's cohesion (0).
+        self.assertEqual((p["status"], p["steps"]), ("complete", 300))
+        self.assertAlmostEqual(p["simulated_time"], 6e-7, delta=1e-15)
+        with open(os.path.join(prep, "parameters.prm")) as f:
+            self.assertRegex(f.read(), r"set Cohesion\s+= 0\s")
+        with open(os.path.join(out, "study_summary.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([r["preparation"] for r in rows], ["preparation_000"] * 4)
+        self.assertEqual([r["status"] for r in rows], ["complete"] * 4)
+        self.assertEqual(len({r["mu_mean"] for r in rows}), 4)  # four different shear phases
+        for r in rows:
+            # "mu_stderr" is the batch-means standard error: positive, below the spread.
+            self.assertGreater(float(r["mu_stderr"]), 0)
+            self.assertLess(float(r["mu_stderr"]), float(r["mu_std"]))
+
+        # Case 3 (V = 5 m/s, cohesion 120 N/m) run alone from the same state: the same rows.
+        alone = os.path.join(self.dir, "alone")
+        run = subprocess.run([TRIBO, "run", os.path.join(self.dir, "base.prm"), "--output", alone, "--quiet",
+                              "--set", "Shear cell/Sliding velocity=5", "--set", "Contact law/Cohesion=120",
+                              "--set", "Contact law/Cohesion range=2.4e-8",
+                              "--set", "Shear cell/Initial state=" + prep], capture_output=True, text=True,
+                             timeout=120)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        with open(os.path.join(alone, "statistics.csv")) as f:
+            alone_rows = f.read()
+        with open(os.path.join(out, "case_003", "statistics.csv")) as f:
+            self.assertEqual(f.read(), alone_rows)
+        with open(os.path.join(alone, "summary.json")) as f:
+            s = json.load(f)
+        # It runs the 700 steps from 6e-7 s to 2e-6 s only, starting from the state's time.
+        self.assertEqual((s["steps"], s["start_time"]), (700, p["simulated_time"]))
+        self.assertAlmostEqual(float(alone_rows.splitlines()[1].split(",")[0]), 6e-7 + 10 * 2e-9, delta=1e-15)
+        self.assertIn("starting from the state of " + prep, open(os.path.join(alone, "log.txt")).read())
+
+        # A second run of the study redoes nothing.
+        log, _ = self.study("Contact law/Cohesion")
+        self.assertIn("preparation 0: complete, skipped", log)
+        self.assertNotIn("running", log)
+
+    def test_the_compaction_follows_the_entries_that_act_before_shear_start(self):
+        # Without Shear-phase entries the cohesion acts in the compaction too: one
+        # compaction per cohesion, each shared by the two sliding velocities.
+        log, out = self.study("")
+        self.assertIn("4 cases shear from 2 shared compactions", log)
+        with open(os.path.join(out, "study_summary.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([r["preparation"] for r in rows],
+                         ["preparation_000", "preparation_001", "preparation_000", "preparation_001"])
+        with open(os.path.join(out, "preparation_001", "parameters.prm")) as f:
+            self.assertRegex(f.read(), r"set Cohesion\s+= 120\s")
+        # Cases that differ in the compaction itself share nothing.
+        with open(os.path.join(self.dir, "study.prm"), "w") as f:
+            f.write(SHARED.format(shear_phase="").replace("Shear cell/Sliding velocity = 2, 5; ", ""))
+        p = subprocess.run([TRIBO, "study", os.path.join(self.dir, "study.prm"), "--output",
+                            os.path.join(self.dir, "apart")], capture_output=True, text=True, timeout=300)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("no shared compaction: every case compacts differently", p.stdout)
+        self.assertFalse([d for d in os.listdir(os.path.join(self.dir, "apart")) if d.startswith("preparation")])
+
+
+class Tradeoff(WithBaseCase):
     def tradeoff(self, reference, command="tradeoff", design="tradeoff"):
         path = os.path.join(self.dir, "tradeoff.prm")
         with open(path, "w") as f:

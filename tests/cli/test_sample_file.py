@@ -155,5 +155,92 @@ class SampleRun(tribo_cli.TempDirTestCase):
         self.assertGreater(float(stats[0]["gap"]), 2.2 * 2 * R)
 
 
+def state_case(end_time, time_step="2e-9", **shear):
+    """shear_case() without a sample file, from the state in directory 'state'."""
+    c = shear_case(end_time=end_time)
+    c["Simulation"]["Time step"] = time_step
+    del c["Shear cell"]["Sample file"]
+    c["Shear cell"]["Initial state"] = "state"
+    c["Shear cell"].update(shear)
+    return c
+
+
+class SnapshotsAndStates(BadInputTestCase):
+    """`tribo sample DIR --time T` prints a snapshot as a sample file; Shear cell/Initial
+    state = DIR goes on from a run's final state at its final time."""
+
+    def make_state(self, out="state", end_time="2e-8", field_interval="4"):
+        write_sample(os.path.join(self.tmp, "sample.csv"), sample_rows())
+        case = shear_case(end_time=end_time)
+        case["Output"]["Field interval"] = field_interval
+        write_prm(os.path.join(self.tmp, "make.prm"), case)
+        r = run(["run", "make.prm", "--output", out, "--quiet"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+
+    def test_a_snapshot_printed_as_a_sample(self):
+        self.make_state()  # 10 steps of 2 ns, snapshots at steps 0, 4, 8 and 10
+        r = run(["sample", "state", "--time", "1.5e-8"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(self.tmp, "state", "fields", "sample_00002.csv")) as f:
+            self.assertEqual(r.stdout, f.read())  # the nearest snapshot: step 8, 1.6e-8 s
+        self.assertIn("(t = 1.6e-08 s)", r.stderr)
+        last = run(["sample", "state"], cwd=self.tmp)
+        with open(os.path.join(self.tmp, "state", "sample_final.csv")) as f:
+            self.assertEqual(last.stdout, f.read())
+        # The grains of the step-8 snapshot: the sample's, moved by their velocity (no
+        # contact: free flight) over 16 ns, to round-off.
+        snap = list(csv.DictReader(r.stdout.splitlines()))
+        grains = [row for row in sample_rows() if row[3] == "grain"]
+        self.assertEqual(len([g for g in snap if g["body"] == "grain"]), len(grains))
+        for g, row in zip([g for g in snap if g["body"] == "grain"], grains):
+            self.assertAlmostEqual(float(g["x"]), row[0] + 1.6e-8 * row[4], delta=1e-9 * R)
+            self.assertAlmostEqual(float(g["y"]), row[1] + 1.6e-8 * row[5], delta=1e-9 * R)
+
+    def test_a_state_goes_on_as_the_run_would(self):
+        self.make_state(out="whole", end_time="4e-8")
+        self.make_state(out="state", end_time="2e-8")
+        write_prm(os.path.join(self.tmp, "on.prm"), state_case("4e-8"))
+        r = run(["run", "on.prm", "--output", "on", "--quiet"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(self.tmp, "on", "summary.json")) as f:
+            summary = json.load(f)
+        self.assertEqual((summary["steps"], summary["steps_planned"]), (10, 10))
+        self.assertAlmostEqual(summary["start_time"], 2e-8, delta=1e-20)
+        with open(os.path.join(self.tmp, "on", "statistics.csv")) as f:
+            on = list(csv.DictReader(f))
+        with open(os.path.join(self.tmp, "whole", "statistics.csv")) as f:
+            whole = list(csv.DictReader(f))[10:]
+        # Steps 11-20 of the whole run, to round-off: the walls falling under the full load
+        # P L (ramp over), the lower wall sliding at V, the grains in flight.
+        self.assertEqual([int(row["step"]) for row in on], list(range(11, 21)))
+        for a, b in zip(on, whole):
+            self.assertAlmostEqual(float(a["time"]), float(b["time"]), delta=1e-20)
+            self.assertAlmostEqual(float(a["upper_wall_y"]), float(b["upper_wall_y"]), delta=1e-9 * R)
+            self.assertAlmostEqual(float(a["upper_wall_vy"]), float(b["upper_wall_vy"]),
+                                   delta=1e-9 * abs(float(b["upper_wall_vy"])))
+            self.assertAlmostEqual(float(a["kinetic_energy_third_body"]), float(b["kinetic_energy_third_body"]),
+                                   delta=1e-9 * float(b["kinetic_energy_third_body"]))
+            self.assertEqual(a["normal_force"], b["normal_force"])
+
+    def test_bad_states(self):
+        self.make_state()
+        msg, _ = self.run_bad_case(state_case("4e-8", time_step="3e-9"))
+        self.assert_parts(msg, "entry 'Shear cell/Initial state'", "expected a state at a whole number of "
+                          "time steps", "ends at t0 = 2e-08 s, 6.66667 steps of Simulation/Time step = 3e-09 s")
+        msg, _ = self.run_bad_case(state_case("1e-8"))
+        self.assert_parts(msg, "expected a state before Simulation/End time = 1e-08 s", "ends at t0 = 2e-08 s")
+        msg, _ = self.run_bad_case(state_case("4e-8", **{"Sample file": "sample.csv"}))
+        self.assert_parts(msg, "expected no initial state together with a Shear cell/Sample file")
+        msg, _ = self.run_bad_case(state_case("4e-8", **{"Length": "1.3e-5"}))
+        self.assert_parts(msg, "expected a run of this case's Shear cell/Length = 1.3e-05 m", "has 1.2e-05 m)")
+        msg, _ = self.run_bad_case(state_case("4e-8", **{"Initial state": "nowhere"}))
+        self.assert_parts(msg, "expected the directory of a completed shear run with a rigid upper wall",
+                          "nowhere has no readable summary.json")
+        msg = self.run_bad(["sample", "nowhere"])
+        self.assert_parts(msg, "error: tribo sample nowhere: no snapshot index nowhere/fields/discs.pvd")
+        msg = self.run_bad(["sample", "state", "--time", "soon"])
+        self.assert_parts(msg, "error: --time 'soon': expected a time in s")
+
+
 if __name__ == "__main__":
     tribo_cli.main()

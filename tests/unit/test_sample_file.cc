@@ -50,13 +50,13 @@ TEST(SampleFile, AFinalStateReadBackStartsTheSameBodies)
       first.scene->before_step(first.system, step);
       mj.step(first.system, first.p.time_step);
     }
-  const std::string text = first.scene->final_sample(first.system);
+  const std::string text = first.scene->sample(first.system);
   const std::string path = ::testing::TempDir() + "sample_final.csv";
   std::ofstream(path) << text;
 
   Cell second({"Shear cell/Sample file=" + path});
   // The same file again, byte for byte: every number read back is the double written.
-  EXPECT_EQ(second.scene->final_sample(second.system), text);
+  EXPECT_EQ(second.scene->sample(second.system), text);
   ASSERT_EQ(second.system.bodies.size(), first.system.bodies.size());
   ASSERT_EQ(second.system.discs.size(), first.system.discs.size());
   std::vector<unsigned int> discs_of(first.system.bodies.size(), 0);
