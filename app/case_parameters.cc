@@ -229,7 +229,10 @@ namespace tribo::app
                       "Thickness of the first body the upper wall stands for, m (> 0; paper: 1.5e-4): "
                       "its mass is density * thickness * L.");
     prm.declare_entry("Profile samples", "500", Integer(1),
-                      "Profile samples, evenly spread over the shearing phase (paper: 500 in steady state).");
+                      "Profile samples: the shearing phase is cut into this many blocks of consecutive steps, "
+                      "each sample the mean over every step of its block (no snapshot that could alias a "
+                      "periodic motion); profiles.csv averages the samples of the steady state (paper: 500 "
+                      "snapshots).");
     prm.declare_entry("Layer thickness", "0", Double(),
                       "Thickness of the profile layers, m (>= 0); 0: one mean diameter.");
     prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");

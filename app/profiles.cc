@@ -21,6 +21,8 @@ namespace tribo::app
       q_sxy,
       q_syx,
       q_count,
+      q_power,
+      q_temperature,
       n_quantities
     };
 
@@ -43,7 +45,8 @@ namespace tribo::app
   const std::vector<std::string> &LayerProfiles::quantity_names()
   {
     static const std::vector<std::string> names = {"vx", "solid_fraction", "sigma_xx", "sigma_yy",
-                                                   "sigma_xy", "sigma_yx", "n_discs"};
+                                                   "sigma_xy", "sigma_yx", "n_discs", "power_dissipated",
+                                                   "granular_temperature"};
     return names;
   }
 
@@ -66,8 +69,8 @@ namespace tribo::app
     , target(layer_target)
   {}
 
-  void LayerProfiles::sample(double t, const dem::ParticleSystem &s, const dem::MoreauJean &mj, double h,
-                             double upper_surface)
+  void LayerProfiles::accumulate(const dem::ParticleSystem &s, const dem::MoreauJean &mj, double h,
+                                 double upper_surface)
   {
     const double y_l = s.bodies[lower].position.y() + inset, y_u = upper_surface;
     const double H   = y_u - y_l;
@@ -100,9 +103,27 @@ namespace tribo::app
           row[j * n_quantities + q_solid_fraction] +=
             disc_area_between(yc, disc.radius, y_l + j * thickness, y_l + (j + 1) * thickness) / area;
       }
+    // Mean velocity per layer, then the fluctuations about it.
+    std::vector<double> vy_mean(layers, 0.0);
+    for (std::size_t d = 0; d < s.discs.size(); ++d)
+      if (s.discs[d].body != lower && s.discs[d].body != upper)
+        vy_mean[grain_layer(s.disc_centre(d).y())] += s.bodies[s.discs[d].body].velocity.y();
     for (unsigned int k = 0; k < layers; ++k)
       if (row[k * n_quantities + q_count] > 0)
-        row[k * n_quantities + q_vx] /= row[k * n_quantities + q_count];
+        {
+          row[k * n_quantities + q_vx] /= row[k * n_quantities + q_count];
+          vy_mean[k] /= row[k * n_quantities + q_count];
+        }
+    for (std::size_t d = 0; d < s.discs.size(); ++d)
+      if (s.discs[d].body != lower && s.discs[d].body != upper)
+        {
+          const int        k = grain_layer(s.disc_centre(d).y());
+          const dem::Vec2 &v = s.bodies[s.discs[d].body].velocity;
+          const double     n = row[k * n_quantities + q_count];
+          if (n > 1)
+            row[k * n_quantities + q_temperature] +=
+              0.5 * (std::pow(v.x() - row[k * n_quantities + q_vx], 2) + std::pow(v.y() - vy_mean[k], 2)) / n;
+        }
 
     // Love-Weber stresses, spread along the lever arms: each contact adds
     // -f (x) l / A for each free disc it touches (l from the disc centre to the
@@ -129,10 +150,17 @@ namespace tribo::app
           row[k * n_quantities + q_syx] += w * c[3];
         }
     };
-    for (const auto &c : mj.contacts())
+    const auto &contacts = mj.contacts();
+    for (std::size_t i = 0; i < contacts.size(); ++i)
       {
+        const dem::Contact &c = contacts[i];
         if (c.r.x() == 0 && c.r.y() == 0)
           continue;
+        // What the contact dissipates, in the layer of its contact point (from disc 1,
+        // which is a disc whatever side 0 is).
+        row[grain_layer(s.disc_centre(c.disc[1]).y() - (s.discs[c.disc[1]].radius + 0.5 * c.gap) * c.normal.y()) *
+              n_quantities +
+            q_power] -= mj.contact_power()[i];
         const dem::Vec2 t(-c.normal.y(), c.normal.x());
         const dem::Vec2 f1 = (c.r.x() * c.normal + c.r.y() * t) / h; // on disc 1
         // Lever arms from each disc centre to the contact point (middle of the gap).
@@ -150,9 +178,26 @@ namespace tribo::app
             spread(yc, yc + l.y(), f, l);
           }
       }
-    times.push_back(t);
-    gap.push_back(H);
-    data.push_back(std::move(row));
+    if (block_sum.empty())
+      block_sum.assign(row.size(), 0.0);
+    for (std::size_t j = 0; j < row.size(); ++j)
+      block_sum[j] += row[j];
+    block_gap += H;
+    ++block_steps;
+  }
+
+  void LayerProfiles::end_block(double t_begin)
+  {
+    if (block_steps == 0)
+      return;
+    for (double &x : block_sum)
+      x /= block_steps;
+    times.push_back(t_begin);
+    gap.push_back(block_gap / block_steps);
+    data.push_back(std::move(block_sum));
+    block_sum.clear();
+    block_gap   = 0;
+    block_steps = 0;
   }
 
   unsigned int LayerProfiles::n_samples_after(double t_start) const
@@ -215,11 +260,11 @@ namespace tribo::app
   }
   void LayerProfiles::save(CheckpointOut &ar) const
   {
-    ar << layers << times << gap << data;
+    ar << layers << times << gap << data << block_sum << block_gap << block_steps;
   }
 
   void LayerProfiles::load(CheckpointIn &ar)
   {
-    ar >> layers >> times >> gap >> data;
+    ar >> layers >> times >> gap >> data >> block_sum >> block_gap >> block_steps;
   }
 } // namespace tribo::app

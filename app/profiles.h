@@ -1,13 +1,14 @@
 #pragma once
 /// @file Profiles across the gap of a shear cell: layers parallel to the walls,
-/// sampled at chosen times and averaged over the samples of the steady state.
+/// accumulated at every step of the shearing phase in consecutive blocks of steps (the
+/// profile samples), and averaged over the blocks of the steady state.
 ///
 /// The gap between the first bodies' surfaces, from y_L + a (y_L the lower wall's
 /// centre line, a the mean wall-disc radius) to the upper surface given by the scene
 /// (a rigid wall: its centre line - a; a deformable body: its bottom face minus the
 /// half-disc radius), is cut into n layers of equal
-/// thickness, n fixed at the first sample (about one mean diameter each).
-/// Per layer and sample:
+/// thickness, n fixed at the first step accumulated (about one mean diameter each).
+/// Per layer and step (a sample is the mean over the steps of its block):
 /// - vx: mean x-velocity of the free discs whose centre lies in the layer
 ///   (Cao et al. 2011 eq. 14; grains whose centre is beyond a wall surface,
 ///   nestled between wall discs, count in the layer next to that wall), m/s;
@@ -20,7 +21,12 @@
 ///   proportion to the height of l_c in each. A layer in static equilibrium then
 ///   carries exactly the mean force transmitted across its horizontal planes:
 ///   sigma_yy = P. Compression positive, Pa. sigma_xy: x-force per unit length
-///   transmitted across a horizontal plane.
+///   transmitted across a horizontal plane;
+/// - power_dissipated: sum of -P_c (MoreauJean::contact_power()) over the contacts whose
+///   contact point lies in the layer, W/m (per metre of depth; the layers sum to the
+///   step's contact dissipation, statistics.csv power_dissipated);
+/// - granular_temperature: (1/2) mean over the layer's free discs of |v - v_k|^2, v_k
+///   their mean velocity in that layer at that step, m^2/s^2 (0 for fewer than 2 discs).
 
 #include "core/checkpoint.h"
 #include "dem/moreau_jean.h"
@@ -44,10 +50,13 @@ namespace tribo::app
     LayerProfiles(unsigned int lower, unsigned int upper, double wall_inset, double layer_target);
     static constexpr unsigned int no_body = ~0u;
 
-    /// Record one sample at time @p t from the state after a step of length @p h,
-    /// with the upper first body's surface at height @p upper_surface (m).
-    void sample(double t, const dem::ParticleSystem &system, const dem::MoreauJean &mj, double h,
-                double upper_surface);
+    /// Add the state after a step of length @p h to the current block, with the upper
+    /// first body's surface at height @p upper_surface (m).
+    void accumulate(const dem::ParticleSystem &system, const dem::MoreauJean &mj, double h,
+                    double upper_surface);
+    /// Close the current block as one sample, at time @p t_begin (s: the beginning of its
+    /// first step); nothing without accumulated steps.
+    void end_block(double t_begin);
 
     /// Mean over the samples with time >= @p t_start: one row per layer,
     /// columns: layer, y (layer centre above the lower wall surface, m), y_over_h
@@ -65,6 +74,8 @@ namespace tribo::app
 
     unsigned int n_layers() const { return layers; }
     unsigned int n_samples() const { return times.size(); }
+    /// Steps accumulated in the current, open block.
+    unsigned int n_open_steps() const { return block_steps; }
     unsigned int n_samples_after(double t_start) const;
     /// Checkpoint: the samples taken so far.
     void save(CheckpointOut &ar) const;
@@ -75,9 +86,13 @@ namespace tribo::app
     double       inset, target;
     unsigned int layers = 0;
     std::vector<double> times;
-    std::vector<double> gap;       ///< gap between the wall surfaces per sample, m
+    std::vector<double> gap;       ///< mean gap between the wall surfaces per sample, m
     /// data[sample][layer * n_quantities + q]
     std::vector<std::vector<double>> data;
+    /// The open block: sums over its steps of the rows and of the gap.
+    std::vector<double> block_sum;
+    double              block_gap   = 0;
+    unsigned int        block_steps = 0;
   };
 
   /// Area (m^2) of the disc of radius @p r centred at height @p yc between the

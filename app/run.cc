@@ -564,7 +564,11 @@ namespace tribo::app
     summary.set("peak_memory", peak_memory_mb());
     JsonObject scene_results;
     if (!stats.rows().empty())
-      scene->summarize(system, stats, scene_results);
+      {
+        scene->summarize(system, stats, scene_results);
+        if (const std::string note = scene->averaging_note(); !note.empty())
+          log(note);
+      }
     summary.set("results", scene_results);
 
     std::map<std::string, double> scalars = {{"time_step", h}, {"steps", double(steps_run)},

@@ -43,6 +43,8 @@ namespace tribo::app
     virtual bool finished() const { return false; }
     /// Scene results for summary.json, from the state and the statistics.
     virtual void summarize(const dem::ParticleSystem &, const TimeSeries &, JsonObject &) {}
+    /// A line for the log after summarize(): which window its means cover; "" for none.
+    virtual std::string averaging_note() const { return ""; }
     /// Extra tables, written as NAME.csv and as the HDF5 group NAME (after summarize()).
     virtual std::map<std::string, TimeSeries> tables() const { return {}; }
     /// The state as a sample file (app/sample_file.h), written with every snapshot as

@@ -145,12 +145,22 @@ namespace tribo::app
                          "detection distance in one step). Use a smaller Simulation/Time step or "
                          "a larger Contact law/Detection distance.");
 
-        // Profile samples evenly spread over the shearing phase.
-        const auto  &k        = prm.shear;
-        const double interval = (prm.end_time - k.shear_start) / k.profile_samples;
-        if (interval > 0 && t >= k.shear_start + (profiles->n_samples() + 0.5) * interval - 0.5 * prm.time_step &&
-            profiles->n_samples() < k.profile_samples)
-          profiles->sample(t, s, mj, prm.time_step, ub.surface);
+        // Profiles from every step of the shearing phase, in blocks of block_steps steps
+        // (Profile samples blocks over the planned shearing phase), each block one sample.
+        const auto &k = prm.shear;
+        if (sliding)
+          {
+            const double        h       = prm.time_step;
+            const unsigned long n_steps = std::max(1L, std::lround(std::ceil(prm.end_time / h - 1e-9)));
+            const unsigned long first   = std::lround(std::ceil(k.shear_start / h - 1e-9));
+            if (block_steps == 0)
+              block_steps = std::max(1UL, (n_steps - std::min(n_steps - 1, first) + k.profile_samples - 1) /
+                                            k.profile_samples);
+            profiles->accumulate(s, mj, h, ub.surface);
+            const unsigned long done = steps_done - std::min(steps_done, first); // shearing steps so far
+            if (done % block_steps == 0 || steps_done >= n_steps)
+              profiles->end_block((steps_done - profiles->n_open_steps()) * h);
+          }
 
         // mu > 0 when the layer resists the lower wall's sliding, whatever the sign of V.
         const double direction = k.sliding_velocity < 0 ? -1.0 : 1.0;
@@ -203,6 +213,18 @@ namespace tribo::app
           return batch_means(window);
         };
         j.set("averaging_start", start);
+        {
+          std::ostringstream note;
+          note << "means over t in [" << start << ", " << t1 << "] s: "
+               << (!sliding        ? "compaction only, its last fifth"
+                   : steady.reached ? "the steady state (mu and the kinetic energy level)"
+                                    : "NOT a steady state (mu or the kinetic energy still drifts): the second "
+                                      "half of the shearing phase");
+          if (sliding)
+            note << "; " << profiles->n_samples_after(steady.start) << " profile samples of " << block_steps
+                 << " steps each";
+          averaging = note.str();
+        }
         j.set("normal_force_mean", stat("lower_wall_normal_force").first);
         j.set("normal_force_stderr", stderr_of("lower_wall_normal_force"));
         j.set("normal_force_target", k.pressure * k.length);
@@ -265,6 +287,7 @@ namespace tribo::app
         j.set("inertial_number", std::abs(k.sliding_velocity) / h_tb * mean_grain_diameter *
                                    std::sqrt(k.density / k.pressure));
         j.set("profile_samples_in_steady_state", long(profiles->n_samples_after(steady.start)));
+        j.set("profile_steps_per_sample", long(block_steps));
 
         // Mean stresses over the layers at least two layers away from the walls.
         for (const std::string q : {"sigma_xx", "sigma_yy", "sigma_xy"})
@@ -274,6 +297,8 @@ namespace tribo::app
             j.set(q + "_stderr", error);
           }
       }
+
+      std::string averaging_note() const override { return averaging; }
 
       std::map<std::string, TimeSeries> tables() const override
       {
@@ -287,7 +312,7 @@ namespace tribo::app
       {
         std::ostringstream random;
         random << rng;
-        ar << random.str() << steps_done << sliding << normal_force;
+        ar << random.str() << steps_done << sliding << normal_force << block_steps;
         profiles->save(ar);
         if (body)
           body->save(ar);
@@ -296,7 +321,7 @@ namespace tribo::app
       void load(CheckpointIn &ar) override
       {
         std::string random;
-        ar >> random >> steps_done >> sliding >> normal_force;
+        ar >> random >> steps_done >> sliding >> normal_force >> block_steps;
         std::istringstream is(random);
         is >> rng;
         profiles->load(ar);
@@ -516,6 +541,8 @@ namespace tribo::app
       std::mt19937                   rng;
       unsigned int                   lower = 0, upper = LayerProfiles::no_body;
       unsigned long                  steps_done = 0;
+      /// Steps per profile sample, fixed at the first shearing step (0 before).
+      unsigned long                  block_steps = 0;
       bool                           sliding    = false; ///< the lower wall has started sliding
       double                         normal_force = 0;   ///< P L at the current ramp, N/m
       double                         lower_wall_diameter = 0, mean_grain_diameter = 0;
@@ -527,6 +554,7 @@ namespace tribo::app
       std::vector<double>            face_start; ///< x of its chain nodes at the start, m
       std::unique_ptr<LayerProfiles> profiles;
       SteadyState                    steady;
+      std::string                    averaging; ///< the log line of averaging_note()
     };
   } // namespace
 

@@ -233,6 +233,7 @@ namespace tribo::dem
 
     // Update, powers and guards.
     body_power.assign(nb, 0.0);
+    std::vector<Eigen::Vector3d> v_mid_of(nb);
     std::pair<double, std::size_t> fastest{0.0, 0}; // speed (m/s) and body
     for (std::size_t b = 0; b < nb; ++b)
       {
@@ -252,6 +253,7 @@ namespace tribo::dem
             throw RunError(os.str());
           }
         const Eigen::Vector3d v_mid = 0.5 * (v_begin[b] + v);
+        v_mid_of[b]                 = v_mid;
         for (int k = 0; k < 3; ++k)
           {
             if (body.drive[k] == Drive::velocity)
@@ -295,6 +297,33 @@ namespace tribo::dem
         report.boundary_energy      = boundary->energy();
         report.boundary_dissipation = boundary->internal_dissipation();
       }
+    // Each contact's power at the mid-step velocities: r . (H_1^T v_1 - H_0^T v_0) / h,
+    // side 0 of a half-disc contact moving as its material point J_A v_A + J_B v_B.
+    power_of_contact.assign(current.size(), 0.0);
+    for (std::size_t i = 0; i < current.size(); ++i)
+      {
+        const Contact  &c = current[i];
+        const Vec2      t(-c.normal.y(), c.normal.x());
+        Eigen::Vector2d u = Eigen::Vector2d::Zero();
+        for (int side = 0; side < 2; ++side)
+          {
+            const double sign = side == 0 ? -1.0 : 1.0;
+            if (side == 0 && c.on_boundary())
+              {
+                Vec2 v_point = Vec2::Zero();
+                for (int k = 0; k < 2; ++k)
+                  v_point += c.node_map[k] *
+                             (0.5 * (node_v_begin[c.node[k]] + boundary->node_velocity(c.node[k])));
+                u -= Eigen::Vector2d(c.normal.dot(v_point), t.dot(v_point));
+                continue;
+              }
+            const Eigen::Vector3d &v = v_mid_of[c.body[side]];
+            u += sign * Eigen::Vector2d(c.normal.dot(v.head<2>()) + c.arm_n[side] * v.z(),
+                                        t.dot(v.head<2>()) + c.arm_t[side] * v.z());
+          }
+        power_of_contact[i] = c.r.dot(u) / h;
+      }
+
     // Two discs overlapping by more than the smallest radius have passed through each
     // other: contacts were missed (something moved too far in one step for the detection
     // to see it coming) or the solver left them unresolved. Stop, naming the fastest mover.

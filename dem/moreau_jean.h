@@ -111,6 +111,12 @@ namespace tribo::dem
     /// External power on each body over the last step (drivers' reactions and
     /// imposed loads times the mean velocity), W/m; sums to StepReport::power_external.
     const std::vector<double> &external_power() const { return body_power; }
+    /// Power of each contact's impulse on the bodies it touches over the last step, W/m:
+    /// P_c = r_c . u_c,mid / h with u_c,mid the relative velocity at the contact (disc 1
+    /// relative to disc 0 or the half-disc) at the mid-step velocities (v_begin + v_end)/2;
+    /// in the order of contacts(). Their sum is StepReport::power_contacts (with a
+    /// deformable body, less its impulse_extra_power()): -P_c is what contact c dissipates.
+    const std::vector<double> &contact_power() const { return power_of_contact; }
     const ContactLaw &law() const { return contact_law; }
     double theta() const { return th; }
     double detection_distance() const { return distance; }
@@ -143,6 +149,7 @@ namespace tribo::dem
     BodyState                state;
     std::vector<Eigen::Vector3d> body_force;
     std::vector<double>          body_power;
+    std::vector<double>          power_of_contact;
     std::vector<Vec2>        centres;
     BoundaryBody               *boundary = nullptr;
     std::unique_ptr<HalfDiscs>  half_discs;

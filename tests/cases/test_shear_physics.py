@@ -133,6 +133,20 @@ class ShearCell(unittest.TestCase):
         self.assertAlmostEqual(self.r["power_balance_ratio"], 1.0, delta=0.05)
         self.assertGreater(p_lb, 0)
 
+    def test_dissipation_per_layer_adds_up_and_every_profile_has_its_error(self):
+        # The layers share the contacts' dissipation: their sum is the mean dissipated
+        # power (the profile blocks start within a block of the averaging start).
+        total = self.profiles["power_dissipated"].sum()
+        self.assertAlmostEqual(total / self.r["power_dissipated_mean"], 1.0, delta=0.01)
+        self.assertTrue(np.all(self.profiles["granular_temperature"] >= 0))
+        self.assertGreater(self.profiles["granular_temperature"][2:-2].min(), 0)
+        for name in ("vx", "solid_fraction", "sigma_yy", "sigma_xy", "power_dissipated", "granular_temperature"):
+            se = self.profiles[name + "_stderr"]
+            self.assertTrue(np.all(np.isfinite(se)) and np.all(se > 0), name)
+        # Profiles from every step: the samples are blocks of consecutive steps that
+        # cover the shearing phase (6500 steps in 3000 blocks of 3 steps at most).
+        self.assertEqual(self.r["profile_steps_per_sample"], 3)
+
     def test_velocity_profile_is_monotone_between_the_walls(self):
         vx = self.profiles["vx"]
         self.assertGreater(vx[0], 0.7 * V)   # next to the sliding lower wall
@@ -147,6 +161,74 @@ class ShearCell(unittest.TestCase):
         self.assertLess(self.r["mu_mean"], 0.15)
         self.assertAlmostEqual(self.cohesive["results"]["cohesion_number"], 1.0, delta=0.05)
         self.assertGreater(self.cohesive["results"]["mu_mean"], self.r["mu_mean"] + 0.02)
+
+
+ALIASING_CASE = """
+subsection Simulation
+  set Scene = shear
+  set Time step = 2.5e-9
+  set End time = 3.6e-5
+end
+subsection Solver
+  set Tolerance = 1e-3
+end
+subsection Shear cell
+  set Number of discs = 360
+  set Length = 2.4e-5
+  set Wall discs = 18
+  set Pressure = 5e7
+  set Sliding velocity = 3
+  set Seed = 7
+  set Profile samples = 200
+end
+subsection Output
+  set Plots = false
+end
+"""
+
+
+class ProfilesOfABouncingWall(unittest.TestCase):
+    """The case of issue 21: the upper wall bounces on the layer with a period of 60-70
+    steps, and 200 profile snapshots 60 steps apart read sigma_yy = 54.5 MPa for P = 50
+    MPa. Profiles accumulated at every step read P, and agree with the wall force within
+    their standard errors."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        case = os.path.join(cls.tmp.name, "case.prm")
+        with open(case, "w") as f:
+            f.write(ALIASING_CASE)
+        cls.out = os.path.join(cls.tmp.name, "out")
+        subprocess.run([TRIBO, "run", case, "--output", cls.out, "--quiet"], check=True, timeout=300)
+        with open(os.path.join(cls.out, "summary.json")) as f:
+            cls.r = json.load(f)["results"]
+        cls.stats = np.genfromtxt(os.path.join(cls.out, "statistics.csv"), delimiter=",", names=True)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_the_wall_still_bounces(self):
+        # What made the snapshots alias: the wall force swings by far more than its mean.
+        window = self.stats["time"] >= self.r["averaging_start"]
+        force = self.stats["lower_wall_normal_force"][window]
+        self.assertGreater(force.std() / (5e7 * 2.4e-5), 0.3)
+
+    def test_interior_sigma_yy_is_P_and_matches_the_wall_force(self):
+        self.assertTrue(self.r["steady_state_reached"])
+        P, L = 5e7, 2.4e-5
+        self.assertAlmostEqual(self.r["sigma_yy_mean"] / P, 1.0, delta=0.03)
+        wall, wall_se = self.r["normal_force_mean"] / L, self.r["normal_force_stderr"] / L
+        combined = np.hypot(wall_se, self.r["sigma_yy_stderr"])
+        self.assertLess(abs(self.r["sigma_yy_mean"] - wall), 2 * combined,
+                        f"sigma_yy {self.r['sigma_yy_mean']:.4g} +/- {self.r['sigma_yy_stderr']:.2g} Pa, "
+                        f"wall {wall:.4g} +/- {wall_se:.2g} Pa")
+
+    def test_the_log_names_the_averaging_window(self):
+        with open(os.path.join(self.out, "log.txt")) as f:
+            log = f.read()
+        self.assertIn("means over t in [%g, 3.6e-05] s: the steady state" % self.r["averaging_start"], log)
 
 
 class WallThroughLayer(unittest.TestCase):

@@ -22,7 +22,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import tribo_cli  # noqa: E402
-from tribo_cli import (COMMON_COLUMNS, PLOTS, PROFILE_COLUMNS, SCENE_COLUMNS,  # noqa: E402
+from tribo_cli import (COMMON_COLUMNS, PLOTS, PROFILE_COLUMNS, PROFILE_QUANTITIES, SCENE_COLUMNS,  # noqa: E402
                        TempDirTestCase, decode_vtu, read_csv, read_json, read_png, read_pvd,
                        read_vtu_with_vtk, run, tmp_files, write_prm)
 
@@ -350,7 +350,7 @@ SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "ave
                    "power_lower_wall_mean", "power_upper_wall_mean", "power_dissipated_mean",
                    "power_third_body_mean", "power_balance_ratio", "power_balance_ratio_stderr",
                    "energy_rate_mean", "power_balance_closure", "inertial_number",
-                   "profile_samples_in_steady_state", "sigma_xx_mean", "sigma_xx_stderr",
+                   "profile_samples_in_steady_state", "profile_steps_per_sample", "sigma_xx_mean", "sigma_xx_stderr",
                    "sigma_yy_mean", "sigma_yy_stderr", "sigma_xy_mean", "sigma_xy_stderr"]
 
 
@@ -639,15 +639,16 @@ class Sliding(ShearRun, unittest.TestCase):
         st = self.stats
         return st["kinetic_energy"] - st["kinetic_energy_third_body"] - st["kinetic_energy_upper_wall"]
 
+    def block_steps(self):
+        """Steps per profile sample: the shearing steps over Profile samples, rounded up."""
+        first, n = round(self.SHEAR_START / self.H), round(self.END_TIME / self.H)
+        return -(-(n - first) // self.SAMPLES)
+
     def sample_times(self):
-        """The times of the profile samples: the first step ending at or after
-        Shear start + (k + 1/2) (End time - Shear start) / Profile samples."""
-        interval = (self.END_TIME - self.SHEAR_START) / self.SAMPLES
-        times = []
-        for t in self.stats["time"]:  # a row at every step
-            if len(times) < self.SAMPLES and t >= self.SHEAR_START + (len(times) + 0.5) * interval - 0.5 * self.H:
-                times.append(t)
-        return np.array(times)
+        """The times of the profile samples: blocks of block_steps() consecutive steps
+        from Shear start on, each at the beginning of its first step."""
+        first, n, b = round(self.SHEAR_START / self.H), round(self.END_TIME / self.H), self.block_steps()
+        return np.array([(first + k * b) * self.H for k in range(-(-(n - first) // b))])
 
     def test_lower_wall(self):
         sliding = self.sliding_rows()
@@ -726,13 +727,21 @@ class Sliding(ShearRun, unittest.TestCase):
         np.testing.assert_array_equal(p["n_samples"], steady.sum())
         # Standard errors by batch means: finite and non-negative, and the grains' velocities
         # do fluctuate from batch to batch in every layer.
-        for q in ("vx", "solid_fraction", "sigma_xx", "sigma_yy", "sigma_xy", "sigma_yx", "n_discs"):
+        for q in PROFILE_QUANTITIES:
             self.assertTrue(np.all(np.isfinite(p[q + "_stderr"]) & (p[q + "_stderr"] >= 0)), q)
         self.assertTrue(np.all(p["vx_stderr"] > 0))
-        # Layers: fixed at the first sample, about one mean diameter each.
+        # Every step of the steady blocks counts: the layers' dissipation adds up to the
+        # mean contact dissipation over those steps (rows ending after the first block's
+        # beginning), to round-off.
+        self.assertEqual(r["profile_steps_per_sample"], self.block_steps())
+        in_blocks = self.stats["time"] > times[steady][0] + 0.5 * self.H
+        np.testing.assert_allclose(p["power_dissipated"].sum(), self.stats["power_dissipated"][in_blocks].mean(),
+                                   rtol=1e-9)
+        self.assertTrue(np.all(p["granular_temperature"] >= 0) and p["granular_temperature"].max() > 0)
+        # Layers: fixed at the first shearing step, about one mean diameter each.
         mwd = self.mean_wall_diameter()
-        gap_at = {t: g for t, g in zip(self.stats["time"], self.stats["gap"])}
-        h_first = gap_at[times[0]] - mwd
+        gap_at = {round(t / self.H): g for t, g in zip(self.stats["time"], self.stats["gap"])}
+        h_first = gap_at[round(times[0] / self.H) + 1] - mwd
         self.assertEqual(n, max(1, int(round(h_first / self.D))))
         # (The layer may still compact after the first sample: only roughly the final thickness.)
         thickness = r["third_body_thickness"] / self.D
@@ -742,7 +751,7 @@ class Sliding(ShearRun, unittest.TestCase):
         self.assertTrue(np.all(np.diff(p["y"]) > 0) and np.all(np.diff(p["y_over_h"]) > 0))
         self.assertLess(p["y_over_h"][0], 1.0 / n)
         self.assertGreater(p["y_over_h"][-1], 1 - 1.0 / n)
-        h_mean = np.mean([gap_at[t] - mwd for t in times[steady]])
+        h_mean = np.mean(self.stats["gap"][in_blocks]) - mwd
         np.testing.assert_allclose(p["y"] / p["y_over_h"], h_mean, rtol=1e-6)
         # Every grain is counted in one layer.
         np.testing.assert_allclose(p["n_discs"].sum(), self.N, rtol=1e-12)

@@ -49,9 +49,10 @@ SCENE_COLUMNS = {
               "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction"],
 }
 #: Columns of profiles.csv (and datasets of the HDF5 group "profiles"), in this order.
-PROFILE_COLUMNS = ["layer", "y", "y_over_h", "vx", "solid_fraction", "sigma_xx", "sigma_yy",
-                   "sigma_xy", "sigma_yx", "n_discs", "n_samples"] + \
-    [q + "_stderr" for q in ("vx", "solid_fraction", "sigma_xx", "sigma_yy", "sigma_xy", "sigma_yx", "n_discs")]
+PROFILE_QUANTITIES = ["vx", "solid_fraction", "sigma_xx", "sigma_yy", "sigma_xy", "sigma_yx", "n_discs",
+                      "power_dissipated", "granular_temperature"]
+PROFILE_COLUMNS = ["layer", "y", "y_over_h"] + PROFILE_QUANTITIES + ["n_samples"] + \
+    [q + "_stderr" for q in PROFILE_QUANTITIES]
 #: PNG plots of a shear run with Output/Plots = true (scripts/plot_run.py).
 PLOTS = ["mu.png", "power.png", "profiles.png"]
 
