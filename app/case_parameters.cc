@@ -31,9 +31,6 @@ namespace tribo::app
       auto             &sc = p.shear;
       if (!sc.sample_file.empty())
         f.fail(E, "no initial state together with a Shear cell/Sample file (each gives the discs)");
-      if (sc.upper_body_model != "rigid")
-        f.fail(E, "no initial state with Shear cell/Upper body model = " + sc.upper_body_model +
-                    " (states start the rigid-wall cell only, not yet the others)");
       const fs::path dir = fs::absolute(fs::path(given).is_absolute()
                                           ? fs::path(given)
                                           : fs::path(f.filename()).parent_path() / given)
@@ -242,7 +239,8 @@ namespace tribo::app
                       "upper_wall (each wall one rigid body; without wall rows both walls are "
                       "generated). A relative path is relative to the case file. Number of discs, "
                       "Mean diameter, Diameter spread and Seed then do not act on the grains; "
-                      "Upper body model = rigid only (docs/outputs.md, 'Sample files').");
+                      "with a deformable Upper body model, the body's surface stands where the upper wall's "
+                      "would (docs/outputs.md, 'Sample files').");
     prm.declare_entry("Initial state", "", Anything(),
                       "The directory of a completed rigid-wall shear run (e.g. a compaction-only run, "
                       "Shear start >= End time) to go on from: the case starts at that run's final time "
@@ -250,7 +248,8 @@ namespace tribo::app
                       "impulses), with this case's parameters from t0 on; the steps before t0 are not "
                       "run. t0 must be a whole number of time steps and before End time; the Length "
                       "must be the run's. A relative path is relative to the case file. Not with "
-                      "Sample file; Upper body model = rigid only (docs/outputs.md, 'Initial states').");
+                      "Sample file. A deformable Upper body model takes the upper wall's place, unloaded, and "
+                      "takes the load over Pressure ramp time from t0 (docs/outputs.md, 'Initial states').");
     prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
                       "rigid: a rough wall of discs with the mass of the first body (the paper's "
                       "classical model); fem: a plane-strain elastic body of that thickness "
@@ -400,9 +399,6 @@ namespace tribo::app
         sc.upper_body_model = f.get(S + "Upper body model");
         if (const std::string sample = f.get(S + "Sample file"); !sample.empty())
           {
-            if (sc.upper_body_model != "rigid")
-              f.fail(S + "Sample file", "no sample file with Shear cell/Upper body model = " +
-                                          sc.upper_body_model + " (samples start the rigid-wall cell only, not yet the others)");
             const std::filesystem::path given(sample);
             sc.sample_file = std::filesystem::absolute(
               given.is_absolute() ? given : std::filesystem::path(f.filename()).parent_path() / given)

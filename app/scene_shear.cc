@@ -74,7 +74,10 @@ namespace tribo::app
       {
         const auto  &k    = prm.shear;
         const double t    = step * prm.time_step;
-        const double ramp = k.ramp_time > 0 ? std::min(1.0, (t + prm.time_step) / k.ramp_time) : 1.0;
+        // A deformable body placed on a state takes its load from the state's time on, on
+        // its own clock; the rigid wall of a state goes on with the state's ramp.
+        const double t_load = body ? t - prm.start_time : t;
+        const double ramp   = k.ramp_time > 0 ? std::min(1.0, (t_load + prm.time_step) / k.ramp_time) : 1.0;
         normal_force                 = ramp * k.pressure * k.length;
         sliding                      = t >= k.shear_start;
         s.bodies[lower].velocity.x() = sliding ? k.sliding_velocity : 0.0;
@@ -445,7 +448,7 @@ namespace tribo::app
       }
 
       /// The discs of Shear cell/Sample file (app/sample_file.h): its walls, or generated
-      /// walls below and above its grains.
+      /// walls below and above its grains; a deformable upper body in the upper wall's place.
       void build_from_sample(dem::ParticleSystem &s)
       {
         const auto &k = prm.shear;
@@ -498,7 +501,27 @@ namespace tribo::app
               s.bodies[b].velocity     = d.velocity;
               s.bodies[b].spin         = d.spin;
             }
-        if (walls_given)
+        if (k.upper_body_model != "rigid")
+          {
+            // The deformable body's surface where the upper wall's was, or just clear of
+            // the grains.
+            double surface = top + 0.01 * mean_diameter_of(k.sample);
+            if (walls_given)
+              {
+                double y = 0, r = 0;
+                int    n = 0;
+                for (const SampleDisc &d : k.sample)
+                  if (d.body == Body::upper_wall)
+                    {
+                      y += d.centre.y();
+                      r += d.radius;
+                      ++n;
+                    }
+                surface = (y - r) / n;
+              }
+            build_deformable_upper_body(surface);
+          }
+        else if (walls_given)
           {
             auto [wall, diameter] = wall_of(Body::upper_wall);
             upper_y_to_surface    = 0.5 * diameter;

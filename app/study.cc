@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -100,30 +101,42 @@ namespace tribo::app
              entry.rfind("Output/", 0) == 0;
     }
 
+    /// The case file @p base with @p overrides, resolved.
+    std::unique_ptr<ParameterFile> resolved_case(dealii::ParameterHandler &prm, const fs::path &base,
+                                                 const std::vector<std::string> &overrides)
+    {
+      declare_case_parameters(prm);
+      auto file = std::make_unique<ParameterFile>(prm);
+      file->parse(base.string());
+      for (const auto &o : overrides)
+        file->set(o);
+      return file;
+    }
+
     /// The compaction a shear case of @p base with @p overrides starts from, as the
     /// overrides of a compaction-only run (its entries that act before Shear start, End
-    /// time = Shear start); "" when the case cannot share one (another scene, a deformable
-    /// upper body, a sample state already given, no compaction or no shearing).
+    /// time = Shear start); "" when the case cannot share one (another scene, a state of
+    /// its own, no compaction or no shearing, or a compaction with a deformable upper body:
+    /// a state holds discs only).
     std::vector<std::string> preparation_of(const fs::path &base, const std::vector<std::string> &overrides,
                                             const std::vector<std::string> &shear_phase)
     {
       dealii::ParameterHandler prm;
-      declare_case_parameters(prm);
-      ParameterFile file(prm);
-      file.parse(base.string());
-      for (const auto &o : overrides)
-        file.set(o);
-      if (file.get("Simulation/Scene") != "shear" || file.get("Shear cell/Upper body model") != "rigid" ||
-          !file.get("Shear cell/Initial state").empty() || file.get_double("Shear cell/Shear start") <= 0 ||
-          file.get_double("Shear cell/Shear start") >= file.get_double("Simulation/End time"))
+      const auto               file = resolved_case(prm, base, overrides);
+      if (file->get("Simulation/Scene") != "shear" || !file->get("Shear cell/Initial state").empty() ||
+          file->get_double("Shear cell/Shear start") <= 0 ||
+          file->get_double("Shear cell/Shear start") >= file->get_double("Simulation/End time"))
         return {};
       std::vector<std::string> preparation;
       for (const auto &o : overrides)
         if (!acts_only_after_shear_start(entry_of(o)) &&
             std::find(shear_phase.begin(), shear_phase.end(), entry_of(o)) == shear_phase.end())
           preparation.push_back(o);
-      preparation.push_back("Simulation/End time=" + file.get("Shear cell/Shear start"));
+      preparation.push_back("Simulation/End time=" + file->get("Shear cell/Shear start"));
       preparation.push_back("Output/Plots=false");
+      dealii::ParameterHandler prepared;
+      if (resolved_case(prepared, base, preparation)->get("Shear cell/Upper body model") != "rigid")
+        return {};
       return preparation;
     }
 
@@ -311,7 +324,7 @@ namespace tribo::app
           }
         if (!all || preparations.size() == cases.size())
           {
-            sharing_note = !all ? "no shared compaction: not every case is a rigid-wall shear case with a "
+            sharing_note = !all ? "no shared compaction: not every case is a shear case with a rigid-wall "
                                   "compaction (0 < Shear start < End time) and no initial state"
                                 : "no shared compaction: every case compacts differently";
             preparations.clear();

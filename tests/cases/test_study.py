@@ -240,6 +240,31 @@ class SharedCompaction(WithBaseCase):
         self.assertIn("preparation 0: complete, skipped", log)
         self.assertNotIn("running", log)
 
+    def test_a_deformable_body_takes_the_walls_place_on_the_shared_compaction(self):
+        check = subprocess.run([TRIBO, "check", os.path.join(self.dir, "base.prm"), "--set",
+                                "Shear cell/Upper body model=fem"], capture_output=True, text=True, timeout=60)
+        if "left out" in check.stderr:
+            self.skipTest("built without TRIBO_WITH_FEM")
+        with open(os.path.join(self.dir, "study.prm"), "w") as f:
+            f.write(SHARED.format(shear_phase="Shear cell/Upper body model").replace(
+                "Shear cell/Sliding velocity = 2, 5; Contact law/Cohesion = 0, 120",
+                "Shear cell/Upper body model = rigid, fem"))
+        out = os.path.join(self.dir, "bodies")
+        p = subprocess.run([TRIBO, "study", os.path.join(self.dir, "study.prm"), "--output", out],
+                           capture_output=True, text=True, timeout=300)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("2 cases shear from 1 shared compaction", p.stdout)
+        prep = np.genfromtxt(os.path.join(out, "preparation_000", "statistics.csv"), delimiter=",", names=True)
+        fem = np.genfromtxt(os.path.join(out, "case_001", "statistics.csv"), delimiter=",", names=True)
+        with open(os.path.join(out, "case_001", "summary.json")) as f:
+            self.assertEqual(json.load(f)["status"], "complete")
+        # The body's surface stands where the wall's was: 10 steps on, the layer's solid
+        # fraction is the compacted one.
+        self.assertAlmostEqual(fem["solid_fraction"][0] / prep["solid_fraction"][-1], 1, delta=1e-6)
+        # It takes its load from the state's time on: 10 steps into the 100-step ramp.
+        self.assertAlmostEqual(fem["normal_force"][0] / (1e8 * 1.2e-5), 0.1, delta=1e-9)
+        self.assertAlmostEqual(fem["normal_force"][-1] / (1e8 * 1.2e-5), 1, delta=1e-9)
+
     def test_the_compaction_follows_the_entries_that_act_before_shear_start(self):
         # Without Shear-phase entries the cohesion acts in the compaction too: one
         # compaction per cohesion, each shared by the two sliding velocities.

@@ -146,6 +146,26 @@ class SampleRun(tribo_cli.TempDirTestCase):
             again = list(csv.DictReader(f))
         self.assertEqual(again[0], stats[0])
 
+    def test_a_deformable_body_in_the_upper_walls_place(self):
+        write_sample(os.path.join(self.tmp, "sample.csv"), sample_rows())
+        case = shear_case(end_time="2e-9")
+        case["Shear cell"]["Upper body model"] = "fem"
+        write_prm(os.path.join(self.tmp, "case.prm"), case)
+        r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
+        if "left out" in r.stderr:
+            self.skipTest("built without TRIBO_WITH_FEM")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(self.tmp, "out", "summary.json")) as f:
+            summary = json.load(f)
+        self.assertEqual(summary["n_discs"], 20 + 12)  # the grains and the lower wall: the body replaces the upper
+        with open(os.path.join(self.tmp, "out", "statistics.csv")) as f:
+            first = list(csv.DictReader(f))[0]
+        # Its surface where the upper wall's was (2.2 d + R + 1.05 R - R), the lower wall's
+        # surface at -0.05 R + R: the grains' area over that gap, after one step of 2 ns.
+        surface_gap = (2.2 * 2 * R + 1.05 * R) - (-0.05 * R + R)
+        self.assertAlmostEqual(float(first["solid_fraction"]) / (20 * math.pi * R * R / (surface_gap * L)), 1,
+                               delta=1e-4)
+
     def test_walls_generated_around_a_sample_of_grains(self):
         rows = sample_rows(walls=False)
         summary, stats = self.run_sample(rows)
