@@ -22,7 +22,7 @@ namespace tribo::app
   namespace
   {
     /// Shear cell/Initial state = @p given: the final sample and time of a completed
-    /// rigid-wall shear run, checked against the case @p p (its Length, time step and End
+    /// shear run, checked against the case @p p (its Length, time step and End
     /// time) into p.shear.initial_state, p.shear.sample and p.start_time.
     void read_initial_state(const ParameterFile &f, const std::string &given, CaseParameters &p)
     {
@@ -38,7 +38,7 @@ namespace tribo::app
       sc.initial_state = dir.string();
       const RunRecord run = read_run_record(dir.string());
       if (run.status != "complete" || run.scene != "shear" || !fs::is_regular_file(dir / "sample_final.csv"))
-        f.fail(E, "the directory of a completed shear run with a rigid upper wall (" + dir.string() +
+        f.fail(E, "the directory of a completed shear run (" + dir.string() +
                     (run.status.empty() ? " has no readable summary.json"
                                         : " has status '" + run.status + "', scene '" + run.scene + "'" +
                                             (fs::is_regular_file(dir / "sample_final.csv") ? ""
@@ -242,7 +242,7 @@ namespace tribo::app
                       "with a deformable Upper body model, the body's surface stands where the upper wall's "
                       "would (docs/outputs.md, 'Sample files').");
     prm.declare_entry("Initial state", "", Anything(),
-                      "The directory of a completed rigid-wall shear run (e.g. a compaction-only run, "
+                      "The directory of a completed shear run (e.g. a compaction-only run, "
                       "Shear start >= End time) to go on from: the case starts at that run's final time "
                       "t0 from its sample_final.csv (grains, walls, their velocities; not the contact "
                       "impulses), with this case's parameters from t0 on; the steps before t0 are not "

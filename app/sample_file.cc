@@ -130,9 +130,9 @@ namespace tribo::app
     if (count(SampleDisc::Body::grain) == 0)
       throw InputError(path + ": no grain rows (body = grain): the sample has no third body");
     const auto lower = count(SampleDisc::Body::lower_wall), upper = count(SampleDisc::Body::upper_wall);
-    if ((lower == 0) != (upper == 0))
-      throw InputError(path + ": rows for the " + std::string(lower ? "lower" : "upper") +
-                       " wall only: give both walls, or neither (then both are generated)");
+    if (lower == 0 && upper > 0)
+      throw InputError(path + ": rows for the upper wall only: give the lower wall too, or neither "
+                       "(then both are generated)");
     if (lower > 0)
       {
         double lower_top = -std::numeric_limits<double>::infinity();

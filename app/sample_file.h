@@ -8,8 +8,10 @@
 /// (the lower wall's velocity is then imposed by the cell). Checks, each failing with the
 /// file, the line and the column: a header other than these columns, a row with another
 /// number of cells, a cell that is not a finite number, a radius <= 0, an unknown body, a
-/// grain outside [0, L) in x; then no grain at all, rows for one wall only, and walls that
-/// overlap (the upper wall's lowest point below the lower wall's highest).
+/// grain outside [0, L) in x; then no grain at all, rows for the upper wall without the
+/// lower wall (lower wall rows alone are a sample of a run with a deformable upper body: the
+/// upper wall or body then goes above the grains), and walls that overlap (the upper wall's
+/// lowest point below the lower wall's highest).
 
 #include "dem/particle_system.h"
 

@@ -98,11 +98,12 @@ namespace tribo::app
 
       std::string description() const override { return body ? body->describe() : ""; }
 
-      /// The grains and both walls; none with a deformable upper body (a sample holds
-      /// discs only).
+      /// The grains and both walls; with a deformable upper body the grains and the lower
+      /// wall (the body is not made of discs: a run from the sample puts its own upper
+      /// body or a generated wall above the grains).
       std::string sample(const dem::ParticleSystem &s) const override
       {
-        return body ? "" : sample_text(s, lower, upper);
+        return sample_text(s, lower, upper);
       }
 
       void attach(dem::MoreauJean &mj) override
@@ -478,14 +479,17 @@ namespace tribo::app
               bottom = std::min(bottom, d.centre.y() - d.radius);
               top    = std::max(top, d.centre.y() + d.radius);
             }
-        const bool walls_given = std::any_of(k.sample.begin(), k.sample.end(),
-                                             [](const SampleDisc &d) { return d.body != Body::grain; });
+        const auto given = [&](Body body) {
+          return std::any_of(k.sample.begin(), k.sample.end(), [&](const SampleDisc &d) { return d.body == body; });
+        };
+        // The reader ensures upper wall rows come with lower wall rows.
+        const bool lower_given = given(Body::lower_wall), upper_given = given(Body::upper_wall);
         // Generated walls clear the grains by a hundredth of a diameter, whatever the
         // wall discs drawn.
         const double clearance = 0.5 * (k.wall_disc_diameter > 0 ? k.wall_disc_diameter
                                                                  : k.mean_diameter * (1 + k.diameter_spread)) +
                                  0.01 * mean_diameter_of(k.sample);
-        if (walls_given)
+        if (lower_given)
           std::tie(lower, lower_wall_diameter) = wall_of(Body::lower_wall);
         else
           {
@@ -506,7 +510,7 @@ namespace tribo::app
             // The deformable body's surface where the upper wall's was, or just clear of
             // the grains.
             double surface = top + 0.01 * mean_diameter_of(k.sample);
-            if (walls_given)
+            if (upper_given)
               {
                 double y = 0, r = 0;
                 int    n = 0;
@@ -521,7 +525,7 @@ namespace tribo::app
               }
             build_deformable_upper_body(surface);
           }
-        else if (walls_given)
+        else if (upper_given)
           {
             auto [wall, diameter] = wall_of(Body::upper_wall);
             upper_y_to_surface    = 0.5 * diameter;

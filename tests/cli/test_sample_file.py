@@ -97,9 +97,9 @@ class BadSampleFiles(BadInputTestCase):
         rows = [r for r in sample_rows() if r[3] != "grain"]
         self.check_file(rows, "no grain rows (body = grain)")
 
-    def test_one_wall_only(self):
-        rows = [r for r in sample_rows() if r[3] != "upper_wall"]
-        self.check_file(rows, "rows for the lower wall only: give both walls, or neither")
+    def test_upper_wall_only(self):
+        rows = [r for r in sample_rows() if r[3] != "lower_wall"]
+        self.check_file(rows, "rows for the upper wall only: give the lower wall too, or neither")
 
     def test_overlapping_walls(self):
         rows = [r if r[3] != "upper_wall" else (r[0], 0.5 * R, R, r[3], 0, 0, 0) for r in sample_rows()]
@@ -165,6 +165,10 @@ class SampleRun(tribo_cli.TempDirTestCase):
         surface_gap = (2.2 * 2 * R + 1.05 * R) - (-0.05 * R + R)
         self.assertAlmostEqual(float(first["solid_fraction"]) / (20 * math.pi * R * R / (surface_gap * L)), 1,
                                delta=1e-4)
+        # Its final sample: the grains and the lower wall (the body is not made of discs).
+        with open(os.path.join(self.tmp, "out", "sample_final.csv")) as f:
+            bodies = [row["body"] for row in csv.DictReader(f)]
+        self.assertEqual((bodies.count("grain"), bodies.count("lower_wall"), bodies.count("upper_wall")), (20, 12, 0))
 
     def test_walls_generated_around_a_sample_of_grains(self):
         rows = sample_rows(walls=False)
@@ -254,7 +258,7 @@ class SnapshotsAndStates(BadInputTestCase):
         msg, _ = self.run_bad_case(state_case("4e-8", **{"Length": "1.3e-5"}))
         self.assert_parts(msg, "expected a run of this case's Shear cell/Length = 1.3e-05 m", "has 1.2e-05 m)")
         msg, _ = self.run_bad_case(state_case("4e-8", **{"Initial state": "nowhere"}))
-        self.assert_parts(msg, "expected the directory of a completed shear run with a rigid upper wall",
+        self.assert_parts(msg, "expected the directory of a completed shear run (",
                           "nowhere has no readable summary.json")
         msg = self.run_bad(["sample", "nowhere"])
         self.assert_parts(msg, "error: tribo sample nowhere: no snapshot index nowhere/fields/discs.pvd")
