@@ -234,6 +234,7 @@ namespace tribo::app
         j.set("normal_force_target", k.pressure * k.length);
         const double h_tb = stat("gap").first - (upper_y_to_surface + 0.5 * lower_wall_diameter);
         j.set("third_body_thickness", h_tb);
+        j.set("third_body_thickness_stderr", stderr_of("gap"));
         j.set("solid_fraction_mean", stat("solid_fraction").first);
         j.set("solid_fraction_stderr", stderr_of("solid_fraction"));
         j.set("face_shift_mean", stat("upper_body_face_shift").first);
@@ -258,9 +259,13 @@ namespace tribo::app
         const double p_lb = stat("power_lower_wall").first, p_ub = stat("power_upper_wall").first;
         const double p_diss = stat("power_dissipated").first;
         j.set("power_lower_wall_mean", p_lb);
+        j.set("power_lower_wall_stderr", stderr_of("power_lower_wall"));
         j.set("power_upper_wall_mean", p_ub);
+        j.set("power_upper_wall_stderr", stderr_of("power_upper_wall"));
         j.set("power_dissipated_mean", p_diss);
+        j.set("power_dissipated_stderr", stderr_of("power_dissipated"));
         j.set("power_third_body_mean", stat("power_free").first);
+        j.set("power_third_body_stderr", stderr_of("power_free"));
         j.set("power_balance_ratio", p_lb != 0 ? p_diss / p_lb : NAN);
         {
           // Per batch: the ratio of the batch means of P_diss and P_LB.

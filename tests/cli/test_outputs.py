@@ -339,16 +339,17 @@ class Collision(RunOnce, unittest.TestCase):
 
 #: summary.json "results" keys of a shear run, in this order (docs/outputs.md).
 COMPACTION_RESULTS = ["sliding", "averaging_start", "normal_force_mean", "normal_force_stderr",
-                      "normal_force_target", "third_body_thickness", "solid_fraction_mean",
-                      "solid_fraction_stderr", "face_shift_mean", "face_shift_stderr",
+                      "normal_force_target", "third_body_thickness", "third_body_thickness_stderr",
+                      "solid_fraction_mean", "solid_fraction_stderr", "face_shift_mean", "face_shift_stderr",
                       "face_shift_max", "face_shift_in_half_discs", "cohesion_number"]
 SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "averaging_start",
                    "normal_force_mean", "normal_force_stderr", "normal_force_target",
-                   "third_body_thickness", "solid_fraction_mean", "solid_fraction_stderr",
-                   "face_shift_mean", "face_shift_stderr", "face_shift_max",
+                   "third_body_thickness", "third_body_thickness_stderr", "solid_fraction_mean",
+                   "solid_fraction_stderr", "face_shift_mean", "face_shift_stderr", "face_shift_max",
                    "face_shift_in_half_discs", "cohesion_number", "mu_mean", "mu_std", "mu_stderr",
-                   "power_lower_wall_mean", "power_upper_wall_mean", "power_dissipated_mean",
-                   "power_third_body_mean", "power_balance_ratio", "power_balance_ratio_stderr",
+                   "power_lower_wall_mean", "power_lower_wall_stderr", "power_upper_wall_mean",
+                   "power_upper_wall_stderr", "power_dissipated_mean", "power_dissipated_stderr",
+                   "power_third_body_mean", "power_third_body_stderr", "power_balance_ratio", "power_balance_ratio_stderr",
                    "energy_rate_mean", "power_balance_closure", "inertial_number",
                    "profile_samples_in_steady_state", "profile_steps_per_sample", "sigma_xx_mean", "sigma_xx_stderr",
                    "sigma_yy_mean", "sigma_yy_stderr", "sigma_xy_mean", "sigma_xy_stderr"]
@@ -692,7 +693,10 @@ class Sliding(ShearRun, unittest.TestCase):
             return m.std(ddof=1) / math.sqrt(len(m))
 
         for key, column in (("mu_stderr", "mu"), ("normal_force_stderr", "lower_wall_normal_force"),
-                            ("solid_fraction_stderr", "solid_fraction")):
+                            ("solid_fraction_stderr", "solid_fraction"), ("third_body_thickness_stderr", "gap"),
+                            ("power_lower_wall_stderr", "power_lower_wall"),
+                            ("power_upper_wall_stderr", "power_upper_wall"),
+                            ("power_dissipated_stderr", "power_dissipated"), ("power_third_body_stderr", "power_free")):
             np.testing.assert_allclose(r[key], stderr(batches(st[column][w])), rtol=1e-9, err_msg=key)
         np.testing.assert_allclose(r["power_balance_ratio_stderr"],
                                    stderr(batches(st["power_dissipated"][w]) / batches(st["power_lower_wall"][w])),
