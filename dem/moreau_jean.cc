@@ -86,16 +86,43 @@ namespace tribo::dem
 
   StepReport MoreauJean::step(ParticleSystem &system, double h)
   {
-    const auto        step_start = std::chrono::steady_clock::now();
-    StepReport        report;
-    const std::size_t nb = system.bodies.size();
+    const auto step_start = std::chrono::steady_clock::now();
+    StepReport report;
+    predict(system, h);
+    set_up_local_problems(system, detect(system, h, report), h, report);
 
-    // Free velocities and the predicted configuration.
+    auto phase         = std::chrono::steady_clock::now();
+    report.solver      = solve_contacts(h);
+    report.time_solver = seconds_since(phase);
+    const LawResidual accuracy   = law_residual(current, state, contact_law, th * h);
+    report.solver.law_residual  = accuracy.relative;
+    report.solver.gap_violation = accuracy.gap_violation;
+    if (global_method() && !report.solver.fell_back)
+      report.solver.residual = accuracy.relative;
+
+    const double deepest_overlap = measure_gaps(h, report);
+    sum_contact_forces(h);
+    const auto fastest = update_bodies(system, h, report);
+    if (boundary)
+      update_boundary_body(h, report);
+    compute_contact_powers(h);
+    check_overlaps(system, h, report, deepest_overlap, fastest);
+    report.kinetic_energy = system.kinetic_energy();
+    report.time_step      = seconds_since(step_start);
+    return report;
+  }
+
+  void MoreauJean::predict(const ParticleSystem &system, double h)
+  {
+    // Free velocities (imposed loads over the step) and the predicted configuration
+    // x + (1 - theta) h v, where contacts are detected and their geometry taken.
+    const std::size_t nb = system.bodies.size();
     state.velocity.resize(nb);
     state.inverse_mass.resize(nb);
-    std::vector<Eigen::Vector3d> v_begin(nb), v_free(nb);
-    std::vector<Vec2>            x_pred(nb);
-    std::vector<double>          angle_pred(nb);
+    v_begin.resize(nb);
+    v_free.resize(nb);
+    x_pred.resize(nb);
+    angle_pred.resize(nb);
     for (std::size_t b = 0; b < nb; ++b)
       {
         const RigidBody &body = system.bodies[b];
@@ -111,7 +138,11 @@ namespace tribo::dem
         angle_pred[b]     = body.angle + (1 - th) * h * body.spin;
       }
 
-    // Detection at the predicted configuration.
+  }
+
+  std::vector<Contact> MoreauJean::detect(const ParticleSystem &system, double h, StepReport &report)
+  {
+    // Disc pairs at the predicted configuration.
     centres.resize(system.discs.size());
     for (std::size_t d = 0; d < system.discs.size(); ++d)
       {
@@ -123,7 +154,6 @@ namespace tribo::dem
     report.time_detection      = seconds_since(phase);
 
     // The boundary body: free state, predicted nodes, half-disc contacts.
-    std::vector<Vec2> node_v_begin;
     if (boundary)
       {
         const unsigned int nn = boundary->n_nodes();
@@ -147,6 +177,12 @@ namespace tribo::dem
         found.insert(found.end(), on_boundary.begin(), on_boundary.end());
       }
 
+    return found;
+  }
+
+  void MoreauJean::set_up_local_problems(const ParticleSystem &system, std::vector<Contact> found, double h,
+                                         StepReport &report)
+  {
     // Geometry of H, the own Delassus blocks, law terms, free velocities, warm start.
     current.clear();
     current.reserve(found.size());
@@ -182,16 +218,12 @@ namespace tribo::dem
       if (c.r.x() != 0 || c.r.y() != 0)
         state.apply_impulse(c, c.r);
 
-    phase              = std::chrono::steady_clock::now();
-    report.solver      = solve_contacts(h);
-    report.time_solver = seconds_since(phase);
-    const LawResidual accuracy   = law_residual(current, state, contact_law, th * h);
-    report.solver.law_residual  = accuracy.relative;
-    report.solver.gap_violation = accuracy.gap_violation;
-    if (global_method() && !report.solver.fell_back)
-      report.solver.residual = accuracy.relative;
+  }
 
-    // Gap measures with the final velocities.
+  double MoreauJean::measure_gaps(double h, StepReport &report)
+  {
+    // Gap measures with the final velocities; the loaded contacts' impulses become the
+    // next step's warm start.
     next_impulse.clear();
     double eps_sum = 0, min_gap_end = 0, min_gap_any = 0;
     for (const Contact &c : current)
@@ -212,7 +244,13 @@ namespace tribo::dem
     report.max_overlap = std::max(0.0, -min_gap_end);
     const double deepest_overlap = std::max(report.max_overlap, -min_gap_any); // any contact
 
+    return deepest_overlap;
+  }
+
+  void MoreauJean::sum_contact_forces(double h)
+  {
     // Contact force on every body over the step.
+    const std::size_t nb = state.velocity.size();
     body_force.assign(nb, Eigen::Vector3d::Zero());
     if (boundary)
       node_impulse.assign(boundary->n_nodes(), Vec2::Zero());
@@ -231,9 +269,14 @@ namespace tribo::dem
           }
       }
 
-    // Update, powers and guards.
+  }
+
+  std::pair<double, std::size_t> MoreauJean::update_bodies(ParticleSystem &system, double h, StepReport &report)
+  {
+    // End velocities and positions, external and contact powers.
+    const std::size_t nb = system.bodies.size();
     body_power.assign(nb, 0.0);
-    std::vector<Eigen::Vector3d> v_mid_of(nb);
+    v_mid_of.resize(nb);
     std::pair<double, std::size_t> fastest{0.0, 0}; // speed (m/s) and body
     for (std::size_t b = 0; b < nb; ++b)
       {
@@ -277,26 +320,34 @@ namespace tribo::dem
             body.position.x() -= shift;
           }
       }
-    if (boundary)
+    return fastest;
+  }
+
+  void MoreauJean::update_boundary_body(double h, StepReport &report)
+  {
+    // The deformable body takes the contact impulses on its nodes; its end velocities
+    // give the nodes' share of the contact power.
+    const unsigned int nn = boundary->n_nodes();
+    if (!state.node_velocity.allFinite())
+      throw RunError("the boundary body's nodes have non-finite velocities: the solver diverged");
+    const auto phase = std::chrono::steady_clock::now();
+    boundary->finalize(node_impulse);
+    report.time_boundary_body += seconds_since(phase);
+    // With the body's own end velocities (not the solver's running copy, which
+    // carries the round-off of many incremental updates), the balance is exact.
+    for (unsigned int i = 0; i < nn; ++i)
       {
-        const unsigned int nn = boundary->n_nodes();
-        if (!state.node_velocity.allFinite())
-          throw RunError("the boundary body's nodes have non-finite velocities: the solver diverged");
-        phase = std::chrono::steady_clock::now();
-        boundary->finalize(node_impulse);
-        report.time_boundary_body += seconds_since(phase);
-        // With the body's own end velocities (not the solver's running copy, which
-        // carries the round-off of many incremental updates), the balance is exact.
-        for (unsigned int i = 0; i < nn; ++i)
-          {
-            const Vec2 v_mid = 0.5 * (node_v_begin[i] + boundary->node_velocity(i));
-            report.power_contacts += node_impulse[i].dot(v_mid) / h;
-          }
-        report.power_contacts += boundary->impulse_extra_power();
-        report.power_external += boundary->external_power();
-        report.boundary_energy      = boundary->energy();
-        report.boundary_dissipation = boundary->internal_dissipation();
+        const Vec2 v_mid = 0.5 * (node_v_begin[i] + boundary->node_velocity(i));
+        report.power_contacts += node_impulse[i].dot(v_mid) / h;
       }
+    report.power_contacts += boundary->impulse_extra_power();
+    report.power_external += boundary->external_power();
+    report.boundary_energy      = boundary->energy();
+    report.boundary_dissipation = boundary->internal_dissipation();
+  }
+
+  void MoreauJean::compute_contact_powers(double h)
+  {
     // Each contact's power at the mid-step velocities: r . (H_1^T v_1 - H_0^T v_0) / h,
     // side 0 of a half-disc contact moving as its material point J_A v_A + J_B v_B.
     power_of_contact.assign(current.size(), 0.0);
@@ -324,6 +375,11 @@ namespace tribo::dem
         power_of_contact[i] = c.r.dot(u) / h;
       }
 
+  }
+
+  void MoreauJean::check_overlaps(const ParticleSystem &system, double h, const StepReport &report,
+                                  double deepest_overlap, const std::pair<double, std::size_t> &fastest) const
+  {
     // Two discs overlapping by more than the smallest radius have passed through each
     // other: contacts were missed (something moved too far in one step for the detection
     // to see it coming) or the solver left them unresolved. Stop, naming the fastest mover.
@@ -358,9 +414,6 @@ namespace tribo::dem
           os << ". " << hint;
         throw RunError(os.str());
       }
-    report.kinetic_energy = system.kinetic_energy();
-    report.time_step      = seconds_since(step_start);
-    return report;
   }
 
   void WarmStart::assign(const std::vector<Entry> &list)

@@ -4,10 +4,14 @@
 /// - free velocity: v_free = v_i + h M^-1 F_ext (constant imposed loads);
 /// - detection at the predicted configuration q_pred = q_i + (1 - theta) h v_i;
 /// - local problems u = W r + u_free with W = H^T M^-1 H, solved by NLGS or the
-///   active-set method or MPRGP (SolverParameters::method);
+///   active-set method, MPRGP or the interior-point method (SolverParameters::method);
 /// - velocity v_{i+1} = v_free + M^-1 H r, position q_{i+1} = q_pred + theta h v_{i+1}.
 /// Imposed-velocity dofs keep their velocity. Impulses are warm-started from
 /// the previous step's contact between the same two discs.
+/// MoreauJean::step() runs these as named phases, in this order: predict(), detect(),
+/// set_up_local_problems(), solve_contacts() (and the law residual), measure_gaps(),
+/// sum_contact_forces(), update_bodies(), update_boundary_body() (with a deformable body),
+/// compute_contact_powers(), check_overlaps().
 
 #include "dem/active_set.h"
 #include "dem/boundary.h"
@@ -134,6 +138,33 @@ namespace tribo::dem
     /// sweeps included), updating state.
     SolveReport solve_contacts(double h);
 
+    // The phases of step(), in order (see the file comment).
+    /// Free velocities v_free = v + h M^-1 F_ext and the predicted configuration
+    /// x + (1 - theta) h v (x_pred, angle_pred), into state and the scratch below.
+    void predict(const ParticleSystem &system, double h);
+    /// Disc pairs, and the half-discs of an attached boundary body (after its own
+    /// prediction), closer than the detection distance at the predicted configuration.
+    std::vector<Contact> detect(const ParticleSystem &system, double h, StepReport &report);
+    /// The local problems of @p found into current: arms (rows of H), own Delassus blocks,
+    /// law terms, free local velocities, warm-start impulses applied to state.
+    void set_up_local_problems(const ParticleSystem &system, std::vector<Contact> found, double h,
+                               StepReport &report);
+    /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
+    /// (returned, m); stores the loaded contacts' impulses as the next warm start.
+    double measure_gaps(double h, StepReport &report);
+    /// body_force (and node_impulse) from the contacts' impulses.
+    void sum_contact_forces(double h);
+    /// End velocities v_free + h M^-1 F_c, positions x_pred + theta h v, powers; returns the
+    /// fastest body's speed (m/s) and index. Throws RunError on a non-finite velocity.
+    std::pair<double, std::size_t> update_bodies(ParticleSystem &system, double h, StepReport &report);
+    /// The boundary body's update with its node impulses, and its powers and energies.
+    void update_boundary_body(double h, StepReport &report);
+    /// power_of_contact at the mid-step velocities.
+    void compute_contact_powers(double h);
+    /// RunError when an overlap exceeds the smallest radius, naming the likely cause.
+    void check_overlaps(const ParticleSystem &system, double h, const StepReport &report, double deepest_overlap,
+                        const std::pair<double, std::size_t> &fastest) const;
+
     double                   th;
     ContactLaw               contact_law;
     NlgsSolver               solver;
@@ -154,5 +185,10 @@ namespace tribo::dem
     BoundaryBody               *boundary = nullptr;
     std::unique_ptr<HalfDiscs>  half_discs;
     std::vector<Vec2>           node_impulse;
+    // Scratch of one step, between its phases.
+    std::vector<Eigen::Vector3d> v_begin, v_free, v_mid_of; ///< (vx, vy, spin) per body
+    std::vector<Vec2>            x_pred;                    ///< predicted positions, m
+    std::vector<double>          angle_pred;                ///< predicted angles, rad
+    std::vector<Vec2>            node_v_begin;              ///< boundary nodes' velocities at the start
   };
 } // namespace tribo::dem
