@@ -6,6 +6,7 @@
 // forces are per metre of depth (N/m) and masses kg/m. Boundary forces are those of the
 // substrate on the block, upward (repulsive) positive.
 #include "app/particle_scenes.h"
+#include "app/steady_state.h"
 
 #include "core/errors.h"
 #include "core/output.h"
@@ -675,7 +676,8 @@ namespace tribo::app
       /// N = floor(f (t_e - t_s) V/a) (t_s slide start, t_e end of the run, f the averaging
       /// fraction, a the substrate spacing), so that the climbs and descents over the
       /// substrate's particles cancel; if N = 0, the last f (t_e - t_s). mu_mean = -sum(F_x)/sum(F_n) over it (rows are
-      /// interval means over equal times), mu_std the standard deviation of the rows' mu.
+      /// interval means over equal times), mu_std the standard deviation of the rows' mu,
+      /// mu_stderr the batch-means standard error of mu_mean (the ratio per batch).
       void summarize(const TimeSeries &stats, double t_end, JsonObject &res) const override
       {
         const auto   t       = stats.column("time");
@@ -696,6 +698,21 @@ namespace tribo::app
         res.set("window_lattice_periods", whole);
         res.set("mu_mean", fn_mean > 0 ? -sign * mean_of(fx, rows) / fn_mean : 0.0);
         res.set("mu_std", std_of(stats.column("mu"), rows));
+        {
+          // Batch means (steady_state.h) of the window's rows in time order, the ratio
+          // formed per batch as for mu_mean.
+          std::vector<double> fx_rows, fn_rows;
+          for (const std::size_t r : rows)
+            {
+              fx_rows.push_back(fx[r]);
+              fn_rows.push_back(fn[r]);
+            }
+          std::vector<double>       ratio = batch_means(fx_rows);
+          const std::vector<double> load  = batch_means(fn_rows);
+          for (std::size_t b = 0; b < ratio.size(); ++b)
+            ratio[b] = load[b] > 0 ? -sign * ratio[b] / load[b] : 0.0;
+          res.set("mu_stderr", batch_standard_error(ratio));
+        }
         res.set("mu_rows_mean", mean_of(stats.column("mu"), rows));
         res.set("normal_force_mean", fn_mean);
         res.set("tangential_force_mean", mean_of(fx, rows));

@@ -184,6 +184,9 @@ class Slider(unittest.TestCase):
         self.assertLess(abs(r["mu_mean"]), 0.02)
         # The block still climbs over the substrate's particles: large but reversible mu(t).
         self.assertGreater(r["mu_std"], 0.1)
+        # The standard error of the mean is positive and far below the fluctuation.
+        self.assertGreater(r["mu_stderr"], 0)
+        self.assertLess(r["mu_stderr"], r["mu_std"])
 
     def test_friction_needs_dissipation(self):
         mu_weak = self.s_high["results"]["mu_mean"]
