@@ -121,7 +121,9 @@ int main(int argc, char **argv)
             }
           if (s.study_file.empty())
             usage_error("'tribo " + args[0] + "' needs a study file");
-          dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+          // TBB threads (the deal.II body's loops): the node's cores shared among the ranks, so that a
+          // case of a serial study runs as `tribo run` does.
+          dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv);
           return tribo::app::run_study(s);
         }
       if (args[0] != "run" && args[0] != "check")

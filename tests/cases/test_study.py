@@ -264,6 +264,17 @@ class SharedCompaction(WithBaseCase):
         # It takes its load from the state's time on: 10 steps into the 100-step ramp.
         self.assertAlmostEqual(fem["normal_force"][0] / (1e8 * 1.2e-5), 0.1, delta=1e-9)
         self.assertAlmostEqual(fem["normal_force"][-1] / (1e8 * 1.2e-5), 1, delta=1e-9)
+        # Run alone from the same state (its own process, deal.II's threads as in the study's
+        # serial process): the same rows.
+        alone = os.path.join(self.dir, "fem_alone")
+        run = subprocess.run([TRIBO, "run", os.path.join(self.dir, "base.prm"), "--output", alone, "--quiet",
+                              "--set", "Shear cell/Upper body model=fem", "--set",
+                              "Shear cell/Initial state=" + os.path.join(out, "preparation_000")],
+                             capture_output=True, text=True, timeout=120)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        with open(os.path.join(alone, "statistics.csv")) as a, \
+                open(os.path.join(out, "case_001", "statistics.csv")) as b:
+            self.assertEqual(a.read(), b.read())
 
     def test_the_compaction_follows_the_entries_that_act_before_shear_start(self):
         # Without Shear-phase entries the cohesion acts in the compaction too: one
