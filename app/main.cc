@@ -73,8 +73,10 @@ int main(int argc, char **argv)
           double      time = NAN;
           for (std::size_t i = 1; i < args.size(); ++i)
             {
-              if (args[i] == "--time" && i + 1 < args.size())
+              if (args[i] == "--time")
                 {
+                  if (i + 1 >= args.size())
+                    usage_error("--time needs a value (a time in s)");
                   const std::string &v = args[++i];
                   std::size_t        used = 0;
                   try

@@ -264,6 +264,8 @@ class SnapshotsAndStates(BadInputTestCase):
         self.assert_parts(msg, "error: tribo sample nowhere: no snapshot index nowhere/fields/discs.pvd")
         msg = self.run_bad(["sample", "state", "--time", "soon"])
         self.assert_parts(msg, "error: --time 'soon': expected a time in s")
+        msg = self.run_bad(["sample", "state", "--time"])
+        self.assert_parts(msg, "error: --time needs a value (a time in s)")
 
 
 if __name__ == "__main__":
