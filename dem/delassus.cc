@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 
+#include <cmath>
+
 namespace tribo::dem
 {
   namespace
@@ -35,7 +37,8 @@ namespace tribo::dem
   } // namespace
 
   Eigen::SparseMatrix<double> assemble_delassus(const std::vector<Contact> &contacts,
-                                                const BodyState &state, DelassusPart part)
+                                                const BodyState &state, DelassusPart part,
+                                                LowRankBodies *low_rank)
   {
     const std::size_t n     = contacts.size();
     const bool        full  = part == DelassusPart::full;
@@ -76,6 +79,7 @@ namespace tribo::dem
 
     // Rigid bodies: s_i s_j H_i^T M^-1 H_j for every pair of contacts on the body.
     std::vector<Eigen::Matrix<double, 3, 2>> h;
+    std::vector<Eigen::VectorXd>             columns; // of U
     for (std::size_t b = 0; b < nb; ++b)
       {
         const auto           &im = state.inverse_mass[b];
@@ -85,6 +89,19 @@ namespace tribo::dem
         h.clear();
         for (unsigned int k = start[b]; k < start[b + 1]; ++k)
           h.push_back(signed_h(contacts[sides[k].first], sides[k].second));
+        if (low_rank && start[b + 1] - start[b] > low_rank->contact_limit)
+          {
+            for (int dof = 0; dof < 3; ++dof)
+              if (m[dof] > 0)
+                {
+                  Eigen::VectorXd u = Eigen::VectorXd::Zero(width * n);
+                  for (unsigned int k = start[b]; k < start[b + 1]; ++k)
+                    for (int a = 0; a < width; ++a)
+                      u[width * sides[k].first + a] += h[k - start[b]](dof, a) * std::sqrt(m[dof]);
+                  columns.push_back(std::move(u));
+                }
+            continue;
+          }
         for (unsigned int p = start[b]; p < start[b + 1]; ++p)
           {
             const Eigen::Matrix<double, 2, 3> hm = (m.asDiagonal() * h[p - start[b]]).transpose();
@@ -112,6 +129,12 @@ namespace tribo::dem
             }
       }
 
+    if (low_rank)
+      {
+        low_rank->U.resize(width * n, columns.size());
+        for (std::size_t k = 0; k < columns.size(); ++k)
+          low_rank->U.col(k) = columns[k];
+      }
     Eigen::SparseMatrix<double> W(width * n, width * n);
     W.setFromTriplets(entries.begin(), entries.end());
     return W;

@@ -10,9 +10,11 @@
 namespace tribo::dem
 {
   FrictionlessProblem::FrictionlessProblem(const std::vector<Contact> &contacts,
-                                           const BodyState            &state)
-    : A(assemble_delassus(contacts, state, DelassusPart::normal))
+                                           const BodyState &state, bool low_rank_bodies)
   {
+    LowRankBodies low_rank;
+    A = assemble_delassus(contacts, state, DelassusPart::normal, low_rank_bodies ? &low_rank : nullptr);
+    U = std::move(low_rank.U);
     const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());
     b.resize(n);
     x.resize(n);
@@ -25,11 +27,11 @@ namespace tribo::dem
         b[i]             = c.u_free.x() + c.shift;
         x[i]             = std::max(0.0, c.r.x() + c.cohesion_impulse);
       }
-    b -= A * cohesion;
+    b -= product(cohesion);
     for (Eigen::Index i = 0; i < n; ++i)
       {
         A.coeffRef(i, i) += contacts[i].compliance;
-        diagonal[i] = A.coeff(i, i);
+        diagonal[i] = A.coeff(i, i) + (U.cols() > 0 ? U.row(i).squaredNorm() : 0.0);
       }
     A.makeCompressed(); // coeffRef inserts a missing diagonal entry uncompressed
     double       loaded_sum = 0;
@@ -74,6 +76,7 @@ namespace tribo::dem
     for (Eigen::Index j = 0; j < p.A.cols(); ++j)
       for (Eigen::SparseMatrix<double>::InnerIterator a(p.A, j); a; ++a)
         a.valueRef() *= p.inv_root[a.row()] * p.inv_root[j];
+    p.U = p.inv_root.asDiagonal() * U;
     p.b = b.cwiseProduct(p.inv_root);
     p.y = x.cwiseQuotient(p.inv_root);
     return p;

@@ -17,6 +17,7 @@
 #include "dem/contact_law.h"
 
 #include <Eigen/Core>
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
 #include <string>
@@ -29,10 +30,14 @@ namespace tribo::dem
   struct FrictionlessProblem
   {
     /// The problem of @p contacts against @p state, whose velocities must already hold the
-    /// contacts' warm-start impulses c.r; x starts at max(0, r_n + gamma h).
-    FrictionlessProblem(const std::vector<Contact> &contacts, const BodyState &state);
+    /// contacts' warm-start impulses c.r; x starts at max(0, r_n + gamma h). With
+    /// @p low_rank_bodies, the bodies with many contacts (walls) are kept out of A as the
+    /// columns U (dem/delassus.h): the operator is A + U U^T.
+    FrictionlessProblem(const std::vector<Contact> &contacts, const BodyState &state,
+                        bool low_rank_bodies = false);
 
-    Eigen::SparseMatrix<double> A;  ///< W_nn + C, both triangles, column-major
+    Eigen::SparseMatrix<double> A;  ///< W_nn + C (- U U^T), both triangles, column-major
+    Eigen::MatrixXd             U;  ///< n x k, k = 0 without low_rank_bodies
     Eigen::VectorXd b;              ///< m/s
     Eigen::VectorXd x;              ///< the warm start, N s/m
     Eigen::VectorXd diagonal;       ///< A_ii
@@ -42,6 +47,11 @@ namespace tribo::dem
     double scale = 0;
 
     Eigen::Index size() const { return b.size(); }
+    /// (A + U U^T) v.
+    Eigen::VectorXd product(const Eigen::VectorXd &v) const
+    {
+      return U.cols() > 0 ? Eigen::VectorXd(A * v + U * (U.transpose() * v)) : Eigen::VectorXd(A * v);
+    }
     /// The mean of the positive entries of @p y (N s/m), or scale without one: the
     /// denominator of the law residual (dem/law_residual.h).
     double mean_loaded(const Eigen::VectorXd &y) const;
@@ -58,6 +68,7 @@ namespace tribo::dem
     {
       Eigen::VectorXd             inv_root; ///< D^(-1/2), x = inv_root y
       Eigen::SparseMatrix<double> A;
+      Eigen::MatrixXd             U; ///< D^(-1/2) U: the operator is A + U U^T
       Eigen::VectorXd             b;
       Eigen::VectorXd             y; ///< the warm start
     };

@@ -34,21 +34,26 @@ namespace tribo::dem
     if (contacts.empty())
       return report;
     require_frictionless(law, "interior-point");
-    const FrictionlessProblem lcp(contacts, state);
+    const FrictionlessProblem lcp(contacts, state, true);
     const Eigen::Index        n = lcp.size();
     // The scaled problem (dem/mprgp.h).
     FrictionlessProblem::Scaled       scaled   = lcp.scaled();
     const Eigen::VectorXd            &inv_root = scaled.inv_root;
     const Eigen::SparseMatrix<double> &A        = scaled.A;
+    const Eigen::MatrixXd            &U        = scaled.U;
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
+    // The operator A' + U U^T (the walls as low-rank columns, dem/delassus.h).
+    auto product = [&](const Eigen::VectorXd &v) -> Eigen::VectorXd {
+      return U.cols() > 0 ? Eigen::VectorXd(A * v + U * (U.transpose() * v)) : Eigen::VectorXd(A * v);
+    };
     // The scale of y: the warm start's loaded impulses, or the free velocities' (A'y = -b'
     // at a solution with unit diagonal), whichever is larger: a warm start of tiny
     // impulses must not shrink the start (nor the target) step after step.
     const double nu = 1e-2 * std::max({(y.array() > 0).any() ? lcp.mean_loaded(y) : 0.0,
                                         b.cwiseAbs().mean(), 1e-300});
     y               = y.cwiseMax(nu);
-    Eigen::VectorXd g = A * y + b, s = g.cwiseMax(nu);
+    Eigen::VectorXd g = product(y) + b, s = g.cwiseMax(nu);
 
     // The natural map in x units: max |min(y_i, g_i)| / sqrt(D_i), y projected on y >= 0.
     auto natural_map = [&]() {
@@ -73,6 +78,25 @@ namespace tribo::dem
         unit[j]     = *diagonal[j];
       }
     Eigen::VectorXd r(n), rhs(n), dy(n), ds(n), dy_a(n), ds_a(n);
+    // K = K_s + U U^T solved through K_s's factorisation (Sherman-Morrison-Woodbury):
+    // K^-1 v = K_s^-1 v - Z (I + U^T Z)^-1 U^T K_s^-1 v, Z = K_s^-1 U.
+    Eigen::MatrixXd          Z;
+    Eigen::LDLT<Eigen::MatrixXd> capacitance;
+    // With the low-rank part, one step of iterative refinement against K itself (the
+    // update loses digits that the plain factorisation keeps: docs/performance.md).
+    Eigen::VectorXd barrier(n); // s / y + shift, K's diagonal beyond A'
+    auto woodbury = [&](const Eigen::VectorXd &v) -> Eigen::VectorXd {
+      Eigen::VectorXd t = cholesky.solve(v);
+      t -= Z * capacitance.solve(U.transpose() * t);
+      return t;
+    };
+    auto solve = [&](const Eigen::VectorXd &v) -> Eigen::VectorXd {
+      if (U.cols() == 0)
+        return cholesky.solve(v);
+      Eigen::VectorXd t = woodbury(v);
+      t += woodbury(v - product(t) - barrier.cwiseProduct(t));
+      return t;
+    };
     // Round-off floor: below 1e-6 of the mean impulse, two iterations in a row that do not
     // halve the natural map end the solve (K's condition grows like 1 / mu).
     double       worst = natural_map(), last_worst = std::numeric_limits<double>::infinity();
@@ -111,7 +135,10 @@ namespace tribo::dem
         for (const double shift : {0.0, 1e-10})
           {
             for (Eigen::Index j = 0; j < n; ++j)
-              *diagonal[j] = unit[j] + s[j] / y[j] + shift;
+              {
+                barrier[j]   = s[j] / y[j] + shift;
+                *diagonal[j] = unit[j] + barrier[j];
+              }
             cholesky.factorize(K);
             ++report.factorizations;
             if ((factorised = cholesky.info() == Eigen::Success))
@@ -122,22 +149,27 @@ namespace tribo::dem
             report.converged = false;
             break;
           }
+        if (U.cols() > 0)
+          {
+            Z = cholesky.solve(U);
+            capacitance.compute(Eigen::MatrixXd::Identity(U.cols(), U.cols()) + U.transpose() * Z);
+          }
         // Predictor (affine scaling).
         rhs  = -r - s;
-        dy_a = cholesky.solve(rhs);
-        ds_a = A * dy_a + r;
+        dy_a = solve(rhs);
+        ds_a = product(dy_a) + r;
         const double alpha_a = std::min(step_to_boundary(y, dy_a, 1.0), step_to_boundary(s, ds_a, 1.0));
         const double mu_a    = (y + alpha_a * dy_a).dot(s + alpha_a * ds_a) / n;
         const double sigma   = std::pow(std::max(0.0, mu_a) / mu, 3);
         // Corrector.
         for (Eigen::Index j = 0; j < n; ++j)
           rhs[j] = -r[j] - s[j] + (sigma * mu - dy_a[j] * ds_a[j]) / y[j];
-        dy = cholesky.solve(rhs);
-        ds = A * dy + r;
+        dy = solve(rhs);
+        ds = product(dy) + r;
         const double alpha = std::min(step_to_boundary(y, dy, 0.995), step_to_boundary(s, ds, 0.995));
         y += alpha * dy;
         s += alpha * ds;
-        g     = A * y + b;
+        g     = product(y) + b;
         worst = natural_map();
         if (!std::isfinite(worst))
           {

@@ -16,27 +16,28 @@ namespace
 {
   const double rho = 7800, radius = 0.5e-6, h = 1e-9;
 
-  /// A hyperstatic packing: three hexagonal rows of four discs (six neighbours each) in
-  /// a periodic cell four diameters wide, on a fixed wall clump, under a wall clump
-  /// free in y and pushed down by @p load (N/m), the lower wall sliding at @p slide m/s.
-  ParticleSystem hexagonal_stack(double load, double slide)
+  /// A hyperstatic packing: three hexagonal rows of @p columns discs (six neighbours each)
+  /// in a periodic cell @p columns diameters wide, on a fixed wall clump, under a wall
+  /// clump free in y and pushed down by @p load (N/m), the lower wall sliding at @p slide
+  /// m/s.
+  ParticleSystem hexagonal_stack(double load, double slide, int columns = 4)
   {
     ParticleSystem s;
     const double   d = 2 * radius, row = d * std::sqrt(3.0) / 2;
-    s.period         = 4 * d;
+    s.period         = columns * d;
     std::vector<Vec2>   wall;
-    std::vector<double> radii(4, radius);
-    for (int i = 0; i < 4; ++i)
+    std::vector<double> radii(columns, radius);
+    for (int i = 0; i < columns; ++i)
       wall.push_back({(i + 0.5) * d, 0});
     const unsigned lower = s.add_clump(wall, radii, rho);
     for (auto &k : s.bodies[lower].drive)
       k = Drive::velocity;
     s.bodies[lower].velocity = {slide, 0};
     for (int j = 1; j <= 3; ++j)
-      for (int i = 0; i < 4; ++i)
+      for (int i = 0; i < columns; ++i)
         s.add_disc({(i + (j % 2 ? 1.0 : 0.5)) * d, j * row}, radius, rho);
     for (auto &p : wall)
-      p = {p.x() + (4 % 2 ? 0.5 * d : 0.0), 4 * row};
+      p = {p.x(), 4 * row}; // row 4 sits like row 0
     const unsigned upper   = s.add_clump(wall, radii, rho);
     s.bodies[upper].drive  = {{Drive::velocity, Drive::force, Drive::velocity}};
     s.bodies[upper].load[1] = -load;
@@ -155,6 +156,55 @@ TEST(ContactSolvers, SparseDelassusEqualsTheDenseOperator)
       EXPECT_LT((dense.block<2, 2>(2 * i, 2 * i) - state.delassus_block(contacts[i])).norm(),
                 1e-12 * dense(2 * i, 2 * i));
     }
+}
+
+TEST(ContactSolvers, WallsAsLowRankColumnsAddUpToTheOperator)
+{
+  // W = W_sparse + U U^T whichever bodies are kept out (contact limit 0: every body that
+  // is not imposed; 6: the walls of this 36-column stack, whose discs have six contacts), both parts; the free wall
+  // contributes one column (its y dof), the discs three each.
+  ParticleSystem s = hexagonal_stack(100, 1, 36);
+  MoreauJean     mj(0.5, ContactLaw{}, SolverParameters{}, 0.1 * radius);
+  mj.step(s, h);
+  const std::vector<Contact> &contacts = mj.contacts();
+  const BodyState             state    = BodyState::of(s);
+  for (const DelassusPart part : {DelassusPart::full, DelassusPart::normal})
+    {
+      const Eigen::MatrixXd W = Eigen::MatrixXd(assemble_delassus(contacts, state, part));
+      for (const unsigned int limit : {0u, 6u})
+        {
+          LowRankBodies   low_rank;
+          low_rank.contact_limit = limit;
+          const Eigen::MatrixXd sparse = Eigen::MatrixXd(assemble_delassus(contacts, state, part, &low_rank));
+          EXPECT_LT((sparse + low_rank.U * low_rank.U.transpose() - W).norm(), 1e-12 * W.norm());
+          EXPECT_EQ(low_rank.U.cols(), limit == 0 ? 1 + 3 * 108 : 1);
+        }
+    }
+}
+
+TEST(ContactSolvers, InteriorPointWithTheWallAsLowRankMatchesConvergedNlgs)
+{
+  // 36 columns: the upper wall carries more than 64 contacts, so the interior-point
+  // method solves through Sherman-Morrison-Woodbury (dem/delassus.h).
+  const ParticleSystem s = hexagonal_stack(3600, 2, 36);
+  {
+    ParticleSystem probe = s;
+    MoreauJean     mj(0.5, ContactLaw{}, SolverParameters{}, 0.1 * radius);
+    mj.step(probe, h);
+    unsigned int on_upper = 0;
+    for (const Contact &c : mj.contacts())
+      on_upper += c.body[0] == 109 || c.body[1] == 109;
+    ASSERT_GT(on_upper, 64u);
+  }
+  SolverParameters ipm;
+  ipm.method          = SolverParameters::Method::interior_point;
+  ipm.residual_target = 1e-11;
+  std::vector<SolveReport> reports;
+  const Eigen::VectorXd v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 3);
+  const Eigen::VectorXd v      = velocities_after(s, ContactLaw{}, ipm, 3, &reports);
+  EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
+  for (const auto &r : reports)
+    EXPECT_LT(r.law_residual, 1e-7);
 }
 
 TEST(ContactSolvers, LawResidualIsZeroWhenSolvedAndPositiveWhenAContactIsLeftUnsolved)
