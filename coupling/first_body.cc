@@ -20,16 +20,55 @@ namespace tribo::coupling
   std::unique_ptr<FirstBody> make_mlp_first_body(const FirstBodyParameters &p);
 #endif
 
+  namespace
+  {
+#ifdef TRIBO_WITH_FEM
+    std::unique_ptr<FirstBody> make_fem_first_body(const FirstBodyParameters &p);
+#endif
+
+    /// The upper first-body models (Shear cell/Upper body model): name, least number of
+    /// chain nodes, the build option of their module and their factory (null when the
+    /// build left the module out).
+    struct FirstBodyModel
+    {
+      const char *name;
+      long        min_chain_nodes;
+      const char *build_option;
+      std::unique_ptr<FirstBody> (*make)(const FirstBodyParameters &);
+    };
+
+    const FirstBodyModel models[] = {
+#ifdef TRIBO_WITH_FEM
+      {"fem", 1, "TRIBO_WITH_FEM", make_fem_first_body},
+      {"reduced", 1, "TRIBO_WITH_FEM", make_fem_first_body},
+#else
+      {"fem", 1, "TRIBO_WITH_FEM", nullptr},
+      {"reduced", 1, "TRIBO_WITH_FEM", nullptr},
+#endif
+#ifdef TRIBO_WITH_SPH
+      {"sph", 8, "TRIBO_WITH_SPH", make_sph_first_body},
+#else
+      {"sph", 8, "TRIBO_WITH_SPH", nullptr},
+#endif
+#ifdef TRIBO_WITH_MLP
+      {"mlp", 4, "TRIBO_WITH_MLP", make_mlp_first_body},
+#else
+      {"mlp", 4, "TRIBO_WITH_MLP", nullptr},
+#endif
+    };
+
+    const FirstBodyModel &model_of(const FirstBodyParameters &p)
+    {
+      for (const FirstBodyModel &m : models)
+        if (p.model == m.name)
+          return m;
+      throw InputError("unknown upper body model '" + p.model + "': expected rigid, fem, reduced, sph or mlp");
+    }
+  } // namespace
+
   unsigned int chain_nodes(const FirstBodyParameters &p)
   {
-    const long n = std::lround(p.length / p.resolution);
-    if (p.model == "fem" || p.model == "reduced")
-      return std::max(1L, n);
-    if (p.model == "sph")
-      return std::max(8L, n);
-    if (p.model == "mlp")
-      return std::max(4L, n);
-    throw InputError("unknown upper body model '" + p.model + "': expected rigid, fem, reduced, sph or mlp");
+    return std::max(model_of(p).min_chain_nodes, std::lround(p.length / p.resolution));
   }
 
   double p_wave_speed(const FirstBodyParameters &p)
@@ -102,12 +141,6 @@ namespace tribo::coupling
 
   namespace
   {
-    [[noreturn, maybe_unused]] void left_out(const std::string &model, const std::string &option)
-    {
-      throw InputError("Shear cell/Upper body model = " + model + " needs a module this build left out (" +
-                       option + "=OFF); rebuild with -D" + option + "=ON");
-    }
-
 #ifdef TRIBO_WITH_FEM
     std::unique_ptr<FirstBody> make_fem_first_body(const FirstBodyParameters &p)
     {
@@ -146,31 +179,10 @@ namespace tribo::coupling
   std::unique_ptr<FirstBody> make_first_body(const FirstBodyParameters &p)
   {
     check_first_body(p);
-    if (p.model == "fem" || p.model == "reduced")
-      {
-#ifdef TRIBO_WITH_FEM
-        return make_fem_first_body(p);
-#else
-        left_out(p.model, "TRIBO_WITH_FEM");
-#endif
-      }
-    if (p.model == "sph")
-      {
-#ifdef TRIBO_WITH_SPH
-        return make_sph_first_body(p);
-#else
-        left_out("sph", "TRIBO_WITH_SPH");
-#endif
-      }
-    if (p.model == "mlp")
-      {
-#ifdef TRIBO_WITH_MLP
-        return make_mlp_first_body(p);
-#else
-        left_out("mlp", "TRIBO_WITH_MLP");
-#endif
-      }
-    chain_nodes(p); // throws for an unknown model
-    return nullptr;
+    const FirstBodyModel &m = model_of(p);
+    if (!m.make)
+      throw InputError("Shear cell/Upper body model = " + p.model + " needs a module this build left out (" +
+                       m.build_option + "=OFF); rebuild with -D" + m.build_option + "=ON");
+    return m.make(p);
   }
 } // namespace tribo::coupling
