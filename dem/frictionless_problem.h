@@ -48,7 +48,10 @@ namespace tribo::dem
 
     Eigen::Index size() const { return b.size(); }
     /// (A + U U^T) v.
-    Eigen::VectorXd product(const Eigen::VectorXd &v) const
+    Eigen::VectorXd product(const Eigen::VectorXd &v) const { return product_with(A, U, v); }
+    /// (@p A + @p U @p U^T) @p v, for this problem and its scaled form.
+    static Eigen::VectorXd product_with(const Eigen::SparseMatrix<double> &A, const Eigen::MatrixXd &U,
+                                        const Eigen::VectorXd &v)
     {
       return U.cols() > 0 ? Eigen::VectorXd(A * v + U * (U.transpose() * v)) : Eigen::VectorXd(A * v);
     }
@@ -71,6 +74,8 @@ namespace tribo::dem
       Eigen::MatrixXd             U; ///< D^(-1/2) U: the operator is A + U U^T
       Eigen::VectorXd             b;
       Eigen::VectorXd             y; ///< the warm start
+      /// (A' + U' U'^T) v.
+      Eigen::VectorXd product(const Eigen::VectorXd &v) const { return product_with(A, U, v); }
     };
     Scaled scaled() const;
 

@@ -44,9 +44,7 @@ namespace tribo::dem
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
     // The operator A' + U U^T (the walls as low-rank columns, dem/delassus.h).
-    auto product = [&](const Eigen::VectorXd &v) -> Eigen::VectorXd {
-      return U.cols() > 0 ? Eigen::VectorXd(A * v + U * (U.transpose() * v)) : Eigen::VectorXd(A * v);
-    };
+    auto product = [&](const Eigen::VectorXd &v) { return scaled.product(v); };
     // The scale of y: the warm start's loaded impulses, or the free velocities' (A'y = -b'
     // at a solution with unit diagonal), whichever is larger: a warm start of tiny
     // impulses must not shrink the start (nor the target) step after step.
