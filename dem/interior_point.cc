@@ -69,7 +69,7 @@ namespace tribo::dem
     cholesky.setMode(Eigen::CholmodSimplicialLLt);
     cholesky.analyzePattern(K);
     std::vector<double *> diagonal(n);
-    Eigen::VectorXd       unit(n); // the diagonal of A' (1 up to round-off)
+    Eigen::VectorXd       unit(n); // the diagonal of the factorised A' (1 up to round-off; 1 - |U_i|^2 with low-rank walls)
     for (Eigen::Index j = 0; j < n; ++j)
       {
         diagonal[j] = &K.coeffRef(j, j);
