@@ -1,6 +1,6 @@
 #include "app/case_parameters.h"
 
-#include "app/particle_scenes.h"
+#include "app/scenes.h"
 #include "app/sample_file.h"
 #include "core/errors.h"
 #include "coupling/first_body.h"
@@ -62,22 +62,9 @@ namespace tribo::app
 
   void declare_case_parameters(dealii::ParameterHandler &prm)
   {
-#ifdef TRIBO_WITH_SPH_SCENES
-    declare_sph_scene_parameters(prm);
-#endif
-#ifdef TRIBO_WITH_MLP_SCENES
-    declare_mlp_scene_parameters(prm);
-#endif
+declare_scene_subsections(prm);
     prm.enter_subsection("Simulation");
-    prm.declare_entry("Scene", "shear",
-                      Selection("collision|shear|sph_slider|sph_plate|mlp_ordering|mlp_compression|mlp_beams"),
-                      "What to simulate: 'collision' (two discs, Cao et al. 2011 Fig. 8); "
-                      "'shear' (the third-body shear cell of Cao et al. 2011: a periodic layer of discs "
-                      "compacted, then sheared, between two rough walls); 'sph_slider' (the SPH "
-                      "slider on a substrate of Maveyraud et al. 1999, subsection SPH slider); 'sph_plate' (the "
-                      "SPH cantilever-plate check, subsection SPH plate); "
-                      "'mlp_ordering', 'mlp_compression', 'mlp_beams' (the movable-lattice-particle "
-                      "scenes of Popov and Filippov 2006, subsection MLP).");
+    declare_scene_entry(prm);
     prm.declare_entry("Time step", "1e-9", Double(), "Time step h, s (> 0).");
     prm.declare_entry("End time", "1e-6", Double(), "Simulated time, s (> 0).");
     prm.declare_entry("Theta", "0.5", Double(0.5, 1.0),

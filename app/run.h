@@ -30,8 +30,7 @@ namespace tribo::app
     std::string              resume_dir;
   };
 
-  /// The checkpoints of one run, shared by every scene's time loop (the NSCD loop of
-  /// run_case() and the SPH and MLP loops of app/particle_scenes.h): where they go
+  /// The checkpoints of one run, written and read by the driver (app/driver.h): where they go
   /// (DIR/checkpoint.bin), when one is due (every Output/Checkpoint interval seconds of wall
   /// time and every Output/Checkpoint step interval steps), what each starts with (the
   /// resolved parameters, which run_case() compares with the case through

@@ -3,6 +3,7 @@
 /// its own columns to statistics.csv and entries to summary.json.
 
 #include "app/case_parameters.h"
+#include "app/driver.h"
 #include "core/output.h"
 #include "dem/moreau_jean.h"
 #include "dem/particle_system.h"
@@ -35,10 +36,10 @@ namespace tribo::app
     virtual double time_step(const dem::ParticleSystem &) const { return prm.time_step; }
     /// Adjust loads before step @p step (e.g. a pressure ramp).
     virtual void before_step(dem::ParticleSystem &, unsigned long /*step*/) {}
-    /// Names of the scene's own statistics columns and their values after a step.
-    virtual std::vector<std::string> columns() const { return {}; }
-    virtual std::vector<double> measure(const dem::ParticleSystem &, const dem::MoreauJean &,
-                                        const dem::StepReport &) { return {}; }
+    /// Measure after every step (the scene's running sums and samples) and add the
+    /// scene's own columns of statistics.csv, as (name, value) pairs, to @p row.
+    virtual void measure(const dem::ParticleSystem &, const dem::MoreauJean &, const dem::StepReport &,
+                         Row & /*row*/) {}
     /// True when the scene's event is over (the run then ends before End time).
     virtual bool finished() const { return false; }
     /// Scene results for summary.json, from the state and the statistics.

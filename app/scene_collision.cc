@@ -37,13 +37,8 @@ namespace tribo::app
         return prm.time_step;
       }
 
-      std::vector<std::string> columns() const override
-      {
-        return {"gap", "relative_normal_velocity", "normal_force", "energy_change"};
-      }
-
-      std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
-                                  const dem::StepReport &) override
+      void measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj, const dem::StepReport &,
+                   Row &row) override
       {
         const double gap = (s.bodies[1].position - s.bodies[0].position).norm() -
                            s.discs[0].radius - s.discs[1].radius;
@@ -62,7 +57,8 @@ namespace tribo::app
         if (touched && !loaded && gap > mj.detection_distance())
           separated = true;
         last_gap = gap;
-        return {gap, vrel, fn, s.kinetic_energy() / energy_start - 1};
+        row("gap", gap)("relative_normal_velocity", vrel)("normal_force", fn)
+          ("energy_change", s.kinetic_energy() / energy_start - 1);
       }
 
       bool finished() const override { return prm.collision.stop_when_separated && separated; }

@@ -243,7 +243,7 @@ namespace tribo::app
 
     // ------------------------------------------------------------------ scenes
 
-    /// What a scene adds to the common loop of run_mlp_scene().
+    /// What an MLP scene adds to MlpSimulation, the family's part of the time loop.
     class MlpScene
     {
     public:
@@ -260,11 +260,10 @@ namespace tribo::app
       virtual void after_step(Particles &, double /*t*/, double /*dt*/) {}
       /// True when the scene has reached its own end (the run stops, complete).
       virtual bool finished() const { return false; }
-      /// Names of the scene's statistics columns.
-      virtual std::vector<std::string> columns() const = 0;
-      /// Values of those columns at time @p t.
-      virtual std::vector<double> measure(const Particles &p, const mlp::Box &box,
-                                          const mlp::ForceField &field, double t) = 0;
+      /// The scene's statistics columns at time @p t as (name, value) pairs (measurements
+      /// due at t are taken here: a row is due).
+      virtual void measure(const Particles &p, const mlp::Box &box, const mlp::ForceField &field, double t,
+                           Row &row) = 0;
       /// Scene results (summary.json "results") and tables (CSV and results.h5 groups).
       virtual void finish(const Particles &p, const mlp::Box &box, const mlp::ForceField &field,
                           const TimeSeries &stats, double t, JsonObject &results,
@@ -322,12 +321,9 @@ namespace tribo::app
             std::to_string(relaxation) + " capped relaxation iterations");
       }
 
-      std::vector<std::string> columns() const override { return {"extent_x", "extent_y"}; }
-
-      std::vector<double> measure(const Particles &p, const mlp::Box &, const mlp::ForceField &,
-                                  double) override
+      void measure(const Particles &p, const mlp::Box &, const mlp::ForceField &, double, Row &row) override
       {
-        return {mlp::extent(p, 0), mlp::extent(p, 1)};
+        row("extent_x", mlp::extent(p, 0))("extent_y", mlp::extent(p, 1));
       }
 
       /// Bragg wave number of the first shell, 1/m: 4 pi/(sqrt(3) c) hexagonal, 2 pi/c square.
@@ -514,21 +510,15 @@ namespace tribo::app
             arrival[k] = t;
       }
 
-      std::vector<std::string> columns() const override
-      {
-        return {"delta_h", "delta_w", "pressure", "probe1_vx", "probe2_vx"};
-      }
-
-      std::vector<double> measure(const Particles &p, const mlp::Box &, const mlp::ForceField &,
-                                  double t) override
+      void measure(const Particles &p, const mlp::Box &, const mlp::ForceField &, double t, Row &row) override
       {
         if (next_map < map_times.size() && t >= map_times[next_map] - 1e-15)
           {
             density_snapshot(p, t);
             ++next_map;
           }
-        return {platen_ratio(p), slab_height(p) / extent0[1], current,
-                p.velocity[probe_index[0]].x(), p.velocity[probe_index[1]].x()};
+        row("delta_h", platen_ratio(p))("delta_w", slab_height(p) / extent0[1])("pressure", current)
+          ("probe1_vx", p.velocity[probe_index[0]].x())("probe2_vx", p.velocity[probe_index[1]].x());
       }
 
       /// Gaussian density map relative to the ideal lattice's mean pi lambda / A_p
@@ -752,19 +742,14 @@ namespace tribo::app
           displacement[b] += dt * v[b] / (nx * ny);
       }
 
-      std::vector<std::string> columns() const override
-      {
-        return {"transverse_traction", "slip", "beam_gap_change", "coordination"};
-      }
-
-      std::vector<double> measure(const Particles &p, const mlp::Box &box, const mlp::ForceField &field,
-                                  double t) override
+      void measure(const Particles &p, const mlp::Box &box, const mlp::ForceField &field, double t,
+                   Row &row) override
       {
         if (t >= start)
           sample_profile(p, box, field);
-        return {forcing, displacement[0] - displacement[1],
-                (mean_y(p, 1) - mean_y(p, 0)) - (beam_y0[1] - beam_y0[0]),
-                mean_coordination(field, p, box)};
+        row("transverse_traction", forcing)("slip", displacement[0] - displacement[1])
+          ("beam_gap_change", (mean_y(p, 1) - mean_y(p, 0)) - (beam_y0[1] - beam_y0[0]))
+          ("coordination", mean_coordination(field, p, box));
       }
 
       /// Adds the per-particle |F_return| (net and bond mean) to the layer of each particle.
@@ -984,24 +969,18 @@ namespace tribo::app
     checked_step(file, field, particles, s.langevin);
   }
 
-  int run_mlp_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o,
-                    RunCheckpoint &checkpoint)
+  namespace
   {
-    install_stop_handlers();
-    const std::string scene_name = file.get("Simulation/Scene");
-    JsonObject        summary;
-    summary.set("case", o.case_file);
-    summary.set("scene", scene_name);
-
-    Particles                 particles;
-    mlp::Box                  box;
-    std::unique_ptr<MlpScene> scene;
-    std::unique_ptr<mlp::ForceField>         field;
-    std::unique_ptr<mlp::LangevinIntegrator> integrator;
-    CommonSettings            s;
-    try
+    /// An MLP scene as the driver runs it: Langevin steps of MLP/Time step, a statistics
+    /// row every Statistics interval steps (the first at t = 0), snapshots every
+    /// Snapshot interval steps, and a guard against a body flying apart.
+    class MlpSimulation : public Simulation
+    {
+    public:
+      MlpSimulation(const ParameterFile &file, Log &log)
+        : s(read_common(file))
+        , scene_name(file.get("Simulation/Scene"))
       {
-        s     = read_common(file);
         scene = make_mlp_scene(file, s, scene_name);
         scene->build(particles, box);
         field = std::make_unique<mlp::ForceField>(s.interaction);
@@ -1009,193 +988,127 @@ namespace tribo::app
         s.langevin = checked_step(file, *field, particles, s.langevin);
         scene->prepare(particles, box, *field, log);
         integrator = std::make_unique<mlp::LangevinIntegrator>(*field, particles, s.langevin);
+        dt         = s.langevin.time_step;
+        n_steps    = std::max(1L, std::lround(std::ceil(s.end_time / dt - 1e-9)));
+        {
+          const auto [E, c_l] = axial_theory(s);
+          std::ostringstream os;
+          os << "scene " << scene_name << ": " << particles.size() << " particles, k_c = "
+             << s.interaction.stiffness << " N/m^2, f0 = " << s.interaction.f0 << " N/m"
+             << (s.mapped ? " (from Young's modulus and Poisson ratio)" : "") << ", E = " << E
+             << " Pa, c_L = " << c_l << " m/s; dt = " << dt << " s (limit "
+             << integrator->max_time_step() << " s), " << n_steps << " steps";
+          log(os.str());
+        }
+        // Escape bound: the initial configuration's half diagonal plus 1000 r0.
+        Vec2 lo = particles.position[0], hi = lo;
+        for (const Vec2 &x : particles.position)
+          {
+            lo = lo.cwiseMin(x);
+            hi = hi.cwiseMax(x);
+          }
+        centre = 0.5 * (lo + hi);
+        bound  = 0.5 * (hi - lo).norm() + 1000 * s.interaction.r0;
+        scene->set_loads(particles, 0);
+        field->compute(particles, box);
       }
-    catch (const InputError &e)
-      {
-        // Already written: the "running" summary; make it say why the run did not start.
-        summary.set("status", "failed");
-        summary.set("error", e.what());
-        atomic_write(dir + "/summary.json", summary.to_string());
-        log(std::string("error: ") + e.what());
-        throw;
-      }
-    const double        dt      = s.langevin.time_step;
-    const unsigned long n_steps = std::max(1L, std::lround(std::ceil(s.end_time / dt - 1e-9)));
-    {
-      const auto [E, c_l] = axial_theory(s);
-      std::ostringstream os;
-      os << "scene " << scene_name << ": " << particles.size() << " particles, k_c = "
-         << s.interaction.stiffness << " N/m^2, f0 = " << s.interaction.f0 << " N/m"
-         << (s.mapped ? " (from Young's modulus and Poisson ratio)" : "") << ", E = " << E
-         << " Pa, c_L = " << c_l << " m/s; dt = " << dt << " s (limit "
-         << integrator->max_time_step() << " s), " << n_steps << " steps";
-      log(os.str());
-    }
 
-    std::vector<std::string> columns = {"time", "step", "kinetic_energy", "kinetic_temperature", "n_pairs"};
-    for (const auto &c : scene->columns())
-      columns.push_back(c);
-    TimeSeries  stats(columns);
-    FieldWriter fields(dir + "/fields");
-    const auto  snapshot = [&](double t) {
-      std::vector<double> net, bond;
-      return_force_magnitudes(*field, particles, box, net, bond);
-      write_particles(fields, t, particles, net, bond);
-    };
-    const auto row = [&](double t, unsigned long step) {
-      const double ke = particles.kinetic_energy();
-      std::vector<double> r = {t, double(step), ke, ke / particles.size(),
-                               double(field->neighbours().pairs().size())};
-      for (double v : scene->measure(particles, box, *field, t))
-        r.push_back(v);
-      stats.add_row(r);
-    };
+      double time() const override { return step * dt; }
+      double end_time() const override { return n_steps * dt; }
+      bool   reached_end(unsigned long k) const override { return k >= n_steps; }
+      bool   finished() const override { return scene->finished(); }
 
-    // Escape bound: the initial configuration's half diagonal plus 1000 r0.
-    Vec2 lo = particles.position[0], hi = lo;
-    for (const Vec2 &x : particles.position)
+      void advance(unsigned long k, const std::function<void(const std::string &)> &) override
       {
-        lo = lo.cwiseMin(x);
-        hi = hi.cwiseMax(x);
+        scene->set_loads(particles, (k + 1) * dt);
+        scene->before_step(particles, k * dt, dt);
+        integrator->step(particles, box);
+        step = k + 1;
+        if (!box.periodic_x)
+          check_bounded(particles, centre, bound, time());
+        scene->after_step(particles, time(), dt);
       }
-    const Vec2   centre = 0.5 * (lo + hi);
-    const double bound  = 0.5 * (hi - lo).norm() + 1000 * s.interaction.r0;
-    scene->set_loads(particles, 0);
-    field->compute(particles, box);
-    std::string   status = "complete", failure;
-    unsigned long step   = 0;
-    double        t      = 0;
-    // After the header (RunCheckpoint), the step and every object's state, in this order.
-    const auto save_checkpoint = [&]() {
-      checkpoint.write([&](CheckpointOut &ar) {
-        ar << step;
+
+      bool row(Row &row) override
+      {
+        const double ke = particles.kinetic_energy();
+        row("kinetic_energy", ke)("kinetic_temperature", ke / particles.size())
+          ("n_pairs", double(field->neighbours().pairs().size()));
+        scene->measure(particles, box, *field, time(), row);
+        return true;
+      }
+      bool row_at_start() const override { return true; }
+      bool row_due(unsigned long k) override { return k % s.statistics_interval == 0; }
+      bool snapshot_due(unsigned long k) override
+      {
+        return s.snapshot_interval > 0 && k % s.snapshot_interval == 0;
+      }
+      void write_snapshot(FieldWriter &fields) override
+      {
+        std::vector<double> net, bond;
+        return_force_magnitudes(*field, particles, box, net, bond);
+        write_particles(fields, time(), particles, net, bond);
+      }
+      /// A failed run's particles have flown apart (check_bounded): no snapshot of them.
+      bool         snapshot_a_failed_state() const override { return false; }
+      unsigned int n_snapshots(const FieldWriter &fields) const override { return fields.n_indexed("particles"); }
+
+      std::string resumed_line(unsigned long k) const override
+      {
+        return "resumed at step " + std::to_string(k) + " (t = " + to_text(time()) + " s) of " +
+               std::to_string(n_steps);
+      }
+
+      void summarize(const RunEnd &end, JsonObject &summary, RunOutputs &out) override
+      {
+        scene->finish(particles, box, *field, end.statistics, time(), out.results, out.tables);
+        summary.set("time_step", dt);
+        summary.set("stable_time_step_limit", integrator->max_time_step());
+        summary.set("steps_planned", long(n_steps));
+        summary.set("n_particles", long(particles.size()));
+        summary.set("pair_stiffness", s.interaction.stiffness);
+        summary.set("return_force_amplitude", s.interaction.f0);
+        out.scalars["time_step"] = dt;
+        if (s.plots)
+          out.plot_script = "plot_mlp.py";
+        std::ostringstream os;
+        os << end.step << " steps in " << end.wall_time << " s";
+        out.last_line = os.str();
+      }
+
+      // After the step number (the driver's), every object's state in this order.
+      void save(CheckpointOut &ar) const override
+      {
         particles.save(ar);
         field->save(ar);
         integrator->save(ar);
         scene->save(ar);
-        stats.save(ar);
-        fields.save(ar);
-      });
+      }
+      void load(CheckpointIn &ar, unsigned long k) override
+      {
+        step = k;
+        particles.load(ar);
+        field->load(ar);
+        integrator->load(ar);
+        scene->load(ar);
+      }
+
+    private:
+      CommonSettings                           s;
+      std::string                              scene_name;
+      Particles                                particles;
+      mlp::Box                                 box;
+      std::unique_ptr<MlpScene>                scene;
+      std::unique_ptr<mlp::ForceField>         field;
+      std::unique_ptr<mlp::LangevinIntegrator> integrator;
+      double                                   dt = 0, bound = 0;
+      Vec2                                     centre;
+      unsigned long                            n_steps = 0, step = 0;
     };
-    if (checkpoint.resuming())
-      {
-        checkpoint.read(log, [&](CheckpointIn &ar) {
-          ar >> step;
-          particles.load(ar);
-          field->load(ar);
-          integrator->load(ar);
-          scene->load(ar);
-          stats.load(ar);
-          fields.load(ar);
-        });
-        t = step * dt;
-        log("resumed at step " + std::to_string(step) + " (t = " + to_text(t) + " s) of " +
-            std::to_string(n_steps));
-      }
-    else
-      {
-        row(0, 0);
-        snapshot(0);
-      }
-    ProgressLine  progress(n_steps * dt, !o.quiet);
-    auto          last_flush = std::chrono::steady_clock::now();
-    try
-      {
-        while (step < n_steps)
-          {
-            if (stop_requested())
-              {
-                save_checkpoint();
-                status = "interrupted";
-                break;
-              }
-            scene->set_loads(particles, (step + 1) * dt);
-            scene->before_step(particles, step * dt, dt);
-            integrator->step(particles, box);
-            ++step;
-            t = step * dt;
-            if (!box.periodic_x)
-              check_bounded(particles, centre, bound, t);
-            scene->after_step(particles, t, dt);
-            if (step % s.statistics_interval == 0 || step == n_steps)
-              row(t, step);
-            if (s.snapshot_interval > 0 && step % s.snapshot_interval == 0 && step != n_steps)
-              snapshot(t);
-            const auto now = std::chrono::steady_clock::now();
-            if (std::chrono::duration<double>(now - last_flush).count() > 10)
-              {
-                atomic_write(dir + "/statistics.csv", stats.to_csv());
-                last_flush = now;
-              }
-            progress.update(t, step);
-            const bool stopping = stop_requested() != 0;
-            if (stopping || (step != n_steps && !scene->finished() && checkpoint.due(step)))
-              save_checkpoint();
-            if (stopping)
-              {
-                status = "interrupted";
-                break;
-              }
-            if (scene->finished())
-              break;
-          }
-      }
-    catch (const RunError &e)
-      {
-        status  = "failed";
-        failure = e.what();
-      }
-    progress.finish();
-    if (stats.rows().back()[1] != double(step))
-      row(t, step);
-    if (status != "failed")
-      snapshot(t);
+  } // namespace
 
-    JsonObject                        results;
-    std::map<std::string, TimeSeries> tables;
-    scene->finish(particles, box, *field, stats, t, results, tables);
-    const double wall = checkpoint.wall_time();
-    summary.set("status", status);
-    if (!failure.empty())
-      summary.set("error", failure);
-    if (status == "interrupted")
-      summary.set("signal", long(stop_requested()));
-    summary.set("time_step", dt);
-    summary.set("stable_time_step_limit", integrator->max_time_step());
-    summary.set("steps", long(step));
-    summary.set("steps_planned", long(n_steps));
-    summary.set("simulated_time", t);
-    summary.set("wall_time", wall);
-    summary.set("n_particles", long(particles.size()));
-    summary.set("pair_stiffness", s.interaction.stiffness);
-    summary.set("return_force_amplitude", s.interaction.f0);
-    summary.set("n_field_snapshots", long(fields.n_indexed("particles")));
-    summary.set("results", results);
-
-    atomic_write(dir + "/statistics.csv", stats.to_csv());
-    for (const auto &[name, table] : tables)
-      atomic_write(dir + "/" + name + ".csv", table.to_csv());
-    const std::map<std::string, double> scalars = {{"time_step", dt}, {"steps", double(step)},
-                                                   {"simulated_time", t}, {"wall_time", wall},
-                                                   {"complete", status == "complete" ? 1.0 : 0.0}};
-    write_results_h5(dir + "/results.h5", stats, tables, file.resolved(), scalars);
-    atomic_write(dir + "/summary.json", summary.to_string());
-    if (status == "complete")
-      checkpoint.remove();
-
-    if (s.plots && status != "failed")
-      {
-        // Plots are a convenience: a missing matplotlib is a warning, not a failure.
-        const std::string command = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR +
-                                    "/scripts/plot_mlp.py " + shell_quote(dir) + " >> " +
-                                    shell_quote(dir + "/log.txt") + " 2>&1";
-        if (std::system(command.c_str()) != 0)
-          log("warning: the plots could not be made (" + command + ")");
-      }
-
-    std::ostringstream os;
-    os << "status " << status << ": " << step << " steps in " << wall << " s";
-    log(os.str());
-    return finish_run(log, status, failure);
+  std::unique_ptr<Simulation> make_mlp_simulation(const ParameterFile &file, Log &log)
+  {
+    return std::make_unique<MlpSimulation>(file, log);
   }
 } // namespace tribo::app

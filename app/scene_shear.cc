@@ -119,16 +119,8 @@ namespace tribo::app
         return {};
       }
 
-      std::vector<std::string> columns() const override
-      {
-        return {"mu", "normal_force", "lower_wall_normal_force", "upper_wall_y", "upper_wall_vy",
-                "gap", "power_lower_wall", "power_upper_wall", "power_dissipated",
-                "kinetic_energy_third_body", "kinetic_energy_upper_wall", "solid_fraction",
-                "elastic_energy_upper_body", "power_damping_upper_body", "upper_body_face_shift"};
-      }
-
-      std::vector<double> measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj,
-                                  const dem::StepReport &r) override
+      void measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj, const dem::StepReport &r,
+                   Row &row) override
       {
         ++steps_done;
         const double t     = steps_done * prm.time_step;
@@ -168,21 +160,14 @@ namespace tribo::app
 
         // mu > 0 when the layer resists the lower wall's sliding, whatever the sign of V.
         const double direction = k.sliding_velocity < 0 ? -1.0 : 1.0;
-        return {F > 0 ? -direction * f[lower].x() / F : 0.0,
-                F,
-                -f[lower].y(),
-                ub.y,
-                ub.vy,
-                gap,
-                power[lower],
-                ub.power,
-                -r.power_contacts,
-                ke_tb,
-                ub.kinetic_energy,
-                grain_area(s) / (surface_gap * k.length),
-                ub.elastic_energy,
-                r.boundary_dissipation,
-                face_shift()};
+        row("mu", F > 0 ? -direction * f[lower].x() / F : 0.0)("normal_force", F)
+          ("lower_wall_normal_force", -f[lower].y())("upper_wall_y", ub.y)("upper_wall_vy", ub.vy)
+          ("gap", gap)("power_lower_wall", power[lower])("power_upper_wall", ub.power)
+          ("power_dissipated", -r.power_contacts)("kinetic_energy_third_body", ke_tb)
+          ("kinetic_energy_upper_wall", ub.kinetic_energy)
+          ("solid_fraction", grain_area(s) / (surface_gap * k.length))
+          ("elastic_energy_upper_body", ub.elastic_energy)("power_damping_upper_body", r.boundary_dissipation)
+          ("upper_body_face_shift", face_shift());
       }
 
       void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override

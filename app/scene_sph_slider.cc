@@ -41,8 +41,7 @@ namespace tribo::app
     const std::string slider_section = "SPH slider";
     const std::string plate_section  = "SPH plate";
 
-    /// Reads entries through a ParameterFile and keeps every value read, keyed by its
-    /// path, for the "parameters" group of results.h5.
+    /// Reads and checks entries through a ParameterFile.
     class EntryReader
     {
     public:
@@ -50,19 +49,17 @@ namespace tribo::app
       /// The value of @p path as text.
       std::string text(const std::string &path)
       {
-        return read[path] = file.get(path);
+        return file.get(path);
       }
       /// A number satisfying @p ok, else InputError "FILE:LINE: entry ... expected @p expected".
       template <typename Check>
       double number(const std::string &path, Check ok, const std::string &expected)
       {
-        read[path] = file.get(path);
         return file.get_checked(path, ok, expected);
       }
       /// An integer >= @p lowest, else InputError naming the entry.
       long integer(const std::string &path, long lowest, const std::string &expected)
       {
-        read[path]   = file.get(path);
         const long v = file.get_integer(path);
         if (v < lowest)
           file.fail(path, expected);
@@ -101,8 +98,6 @@ namespace tribo::app
       {
         file.fail(path, expected);
       }
-      std::map<std::string, std::string> read;
-
     private:
       const ParameterFile &file;
     };
@@ -327,23 +322,22 @@ namespace tribo::app
       return os.str();
     }
 
-    /// What a scene adds to the common explicit loop: its columns, its per-step
-    /// bookkeeping, its rows and its summary.
+    /// What an SPH scene adds to SphSimulation, the family's part of the time loop: its
+    /// step limit, its per-step bookkeeping, its rows and its summary.
     template <int dim>
     class Experiment
     {
     public:
       virtual ~Experiment() = default;
-      /// Columns of statistics.csv after "time", "step", "dt".
-      virtual std::vector<std::string> columns() const = 0;
       /// Largest step allowed now (to land on an event time), s.
       virtual double step_limit(const sph::Solver<dim> &) const { return std::numeric_limits<double>::infinity(); }
       /// Before each step (state at the start of the step).
       virtual void before_step(sph::Solver<dim> &solver) = 0;
       /// After a step of length @p dt.
       virtual void after_step(sph::Solver<dim> &solver, double dt) = 0;
-      /// The scene's values of a statistics row; resets the interval averages.
-      virtual std::vector<double> row(const sph::Solver<dim> &solver) = 0;
+      /// The scene's columns of a statistics row (after "time", "step", "dt") as (name,
+      /// value) pairs; resets the interval averages.
+      virtual void row(const sph::Solver<dim> &solver, Row &row) = 0;
       /// Results of the run for summary.json "results" from the statistics.
       virtual void summarize(const TimeSeries &stats, double t_end, JsonObject &results) const = 0;
       /// Checkpoint: what the scene carries from step to step (its accumulators and phase);
@@ -359,163 +353,122 @@ namespace tribo::app
       double      end_time = 0, statistics_interval = 0, field_interval = 0;
     };
 
-    /// The explicit time loop shared by the SPH scenes: RK2 steps until the end time,
-    /// statistics rows every statistics interval of simulated time, VTU snapshots
-    /// fields/particles_NNNNN.vtu indexed in fields/particles.pvd, checkpoints (and the
-    /// continuation of a resumed run) through @p checkpoint, SIGINT/SIGTERM (a checkpoint,
-    /// status "interrupted", exit 128 + N) and RunError (status "failed", exit 1), each
-    /// keeping the outputs of the steps done. Returns the exit code.
+    /// An SPH scene as the driver runs it: RK2 steps of adaptive length until the end
+    /// time, statistics rows every statistics interval of simulated time (the first at
+    /// t = 0), VTU snapshots fields/particles_NNNNN.vtu indexed in fields/particles.pvd
+    /// every field interval (0: the first and the last only).
     template <int dim>
-    int run_loop(sph::Solver<dim> &solver, Experiment<dim> &exp, const LoopSettings &ls,
-                 const std::map<std::string, std::string> &parameters, JsonObject summary,
-                 const std::string &dir, Log &log, const RunOptions &o, RunCheckpoint &checkpoint)
+    class SphSimulation : public Simulation
     {
-      install_stop_handlers();
-      std::vector<std::string> columns = {"time", "step", "dt"};
-      for (const auto &c : exp.columns())
-        columns.push_back(c);
-      TimeSeries  stats(columns);
-      FieldWriter fields((fs::path(dir) / "fields").string());
-      const auto  snapshot = [&]() {
+    public:
+      /// The scene @p make_experiment builds on the solver @p s.
+      SphSimulation(const LoopSettings &settings, std::unique_ptr<sph::Solver<dim>> s,
+                    const std::function<std::unique_ptr<Experiment<dim>>(sph::Solver<dim> &)> &make_experiment)
+        : ls(settings)
+        , solver(std::move(s))
+        , exp(make_experiment(*solver))
+        , next_row(ls.statistics_interval)
+        , next_field(ls.field_interval > 0 ? ls.field_interval : 2 * ls.end_time)
+      {}
+
+      /// Extra integer entries of summary.json (the sizes of the scene's groups).
+      void set_counts(std::vector<std::pair<std::string, long>> c) { counts = std::move(c); }
+
+      double time() const override { return solver->time; }
+      double end_time() const override { return ls.end_time; }
+      bool   reached_end(unsigned long) const override { return solver->time >= ls.end_time * (1 - 1e-12); }
+
+      void advance(unsigned long, const std::function<void(const std::string &)> &) override
+      {
+        exp->before_step(*solver);
+        dt    = solver->step(std::min(ls.end_time - solver->time, exp->step_limit(*solver)));
+        dt_lo = std::min(dt_lo, dt);
+        dt_hi = std::max(dt_hi, dt);
+        exp->after_step(*solver, dt);
+      }
+
+      bool row(Row &row) override
+      {
+        row("dt", dt);
+        exp->row(*solver, row);
+        return true;
+      }
+      bool row_at_start() const override { return true; }
+      bool row_due(unsigned long) override
+      {
+        if (solver->time < next_row * (1 - 1e-12))
+          return false;
+        while (next_row <= solver->time * (1 + 1e-12))
+          next_row += ls.statistics_interval;
+        return true;
+      }
+      bool snapshot_due(unsigned long) override
+      {
+        if (solver->time < next_field * (1 - 1e-12))
+          return false;
+        while (next_field <= solver->time * (1 + 1e-12))
+          next_field += ls.field_interval;
+        return true;
+      }
+
+      void write_snapshot(FieldWriter &fields) override
+      {
         char name[40];
         std::snprintf(name, sizeof name, "particles_%05u.vtu", fields.n_indexed("particles"));
-        atomic_write((fs::path(dir) / "fields" / name).string(), particle_vtu(solver));
-        fields.index("particles", solver.time, name);
-      };
-      unsigned long step = 0;
-      double        dt = 0, dt_lo = std::numeric_limits<double>::infinity(), dt_hi = 0;
-      const auto    add_row = [&]() {
-        std::vector<double> row = {solver.time, double(step), dt};
-        for (double v : exp.row(solver))
-          row.push_back(v);
-        stats.add_row(row);
-      };
-      std::string status = "complete", failure;
-      double      next_row   = ls.statistics_interval;
-      double      next_field = ls.field_interval > 0 ? ls.field_interval : 2 * ls.end_time;
-      const auto  save_checkpoint = [&]() {
-        checkpoint.write([&](CheckpointOut &ar) {
-          ar << step << dt << dt_lo << dt_hi << next_row << next_field;
-          solver.save(ar);
-          exp.save(ar);
-          stats.save(ar);
-          fields.save(ar);
-        });
-      };
-      if (checkpoint.resuming())
-        {
-          checkpoint.read(log, [&](CheckpointIn &ar) {
-            ar >> step >> dt >> dt_lo >> dt_hi >> next_row >> next_field;
-            solver.load(ar);
-            exp.load(ar);
-            stats.load(ar);
-            fields.load(ar);
-          });
-          if (ls.field_interval <= 0) // first and last only, whatever the end time now
-            next_field = 2 * ls.end_time;
-          std::ostringstream os;
-          os << "resumed at step " << step << " (t = " << solver.time << " s) of the run to " << ls.end_time << " s";
-          log(os.str());
-        }
-      else
-        {
-          snapshot();
-          add_row();
-        }
-      ProgressLine progress(ls.end_time, !o.quiet);
-      auto         last_flush = std::chrono::steady_clock::now();
-      try
-        {
-          while (solver.time < ls.end_time * (1 - 1e-12))
-            {
-              if (stop_requested())
-                {
-                  save_checkpoint();
-                  status = "interrupted";
-                  break;
-                }
-              exp.before_step(solver);
-              dt = solver.step(std::min(ls.end_time - solver.time, exp.step_limit(solver)));
-              ++step;
-              dt_lo = std::min(dt_lo, dt);
-              dt_hi = std::max(dt_hi, dt);
-              exp.after_step(solver, dt);
-              const bool last = solver.time >= ls.end_time * (1 - 1e-12);
-              if (solver.time >= next_row * (1 - 1e-12))
-                {
-                  add_row();
-                  while (next_row <= solver.time * (1 + 1e-12))
-                    next_row += ls.statistics_interval;
-                }
-              if (solver.time >= next_field * (1 - 1e-12) && !last)
-                {
-                  snapshot();
-                  while (next_field <= solver.time * (1 + 1e-12))
-                    next_field += ls.field_interval;
-                }
-              progress.update(solver.time, step);
-              const auto now = std::chrono::steady_clock::now();
-              if (std::chrono::duration<double>(now - last_flush).count() > 10)
-                {
-                  atomic_write((fs::path(dir) / "statistics.csv").string(), stats.to_csv());
-                  last_flush = now;
-                }
-              const bool stopping = stop_requested() != 0;
-              if (stopping || (!last && checkpoint.due(step)))
-                save_checkpoint();
-              if (stopping)
-                {
-                  status = "interrupted";
-                  break;
-                }
-            }
-        }
-      catch (const RunError &e)
-        {
-          status  = "failed";
-          failure = e.what();
-        }
-      progress.finish();
-      if (stats.rows().back()[1] != double(step))
-        add_row();
-      snapshot();
+        atomic_write((fs::path(fields.directory()) / name).string(), particle_vtu(*solver));
+        fields.index("particles", solver->time, name);
+      }
+      unsigned int n_snapshots(const FieldWriter &fields) const override { return fields.n_indexed("particles"); }
 
-      const double wall = checkpoint.wall_time();
-      summary.set("status", status);
-      if (!failure.empty())
-        summary.set("error", failure);
-      if (status == "interrupted")
-        summary.set("signal", long(stop_requested()));
-      summary.set("scene", ls.scene);
-      summary.set("dimension", long(dim));
-      summary.set("steps", long(step));
-      summary.set("simulated_time", solver.time);
-      summary.set("end_time", ls.end_time);
-      summary.set("wall_time", wall);
-      summary.set("dt_min", step ? dt_lo : 0.0);
-      summary.set("dt_max", dt_hi);
-      summary.set("last_step_limiter", solver.last_limiter());
-      summary.set("n_particles", long(solver.state.size()));
-      summary.set("n_field_snapshots", long(fields.n_indexed("particles")));
-      JsonObject results;
-      exp.summarize(stats, solver.time, results);
-      summary.set("results", results);
+      std::string resumed_line(unsigned long step) const override
+      {
+        std::ostringstream os;
+        os << "resumed at step " << step << " (t = " << solver->time << " s) of the run to " << ls.end_time << " s";
+        return os.str();
+      }
 
-      const std::map<std::string, double> scalars = {
-        {"steps", double(step)}, {"simulated_time", solver.time}, {"wall_time", wall},
-        {"dt_min", step ? dt_lo : 0.0}, {"dt_max", dt_hi}, {"complete", status == "complete" ? 1.0 : 0.0}};
-      atomic_write((fs::path(dir) / "statistics.csv").string(), stats.to_csv());
-      write_results_h5((fs::path(dir) / "results.h5").string(), stats, {}, parameters, scalars);
-      atomic_write((fs::path(dir) / "summary.json").string(), summary.to_string());
-      if (status == "complete")
-        checkpoint.remove();
+      void summarize(const RunEnd &end, JsonObject &summary, RunOutputs &out) override
+      {
+        for (const auto &[name, value] : counts)
+          summary.set(name, value);
+        summary.set("dimension", long(dim));
+        summary.set("end_time", ls.end_time);
+        summary.set("dt_min", end.step ? dt_lo : 0.0);
+        summary.set("dt_max", dt_hi);
+        summary.set("last_step_limiter", solver->last_limiter());
+        summary.set("n_particles", long(solver->state.size()));
+        exp->summarize(end.statistics, solver->time, out.results);
+        out.scalars["dt_min"] = end.step ? dt_lo : 0.0;
+        out.scalars["dt_max"] = dt_hi;
+        std::ostringstream os;
+        os << end.step << " steps to t = " << solver->time << " s in " << end.wall_time << " s; step "
+           << (end.step ? dt_lo : 0.0) << " .. " << dt_hi << " s";
+        out.last_line = os.str();
+      }
 
-      std::ostringstream os;
-      os << "status " << status << ": " << step << " steps to t = " << solver.time << " s in " << wall
-         << " s; step " << (step ? dt_lo : 0.0) << " .. " << dt_hi << " s";
-      log(os.str());
-      return finish_run(log, status, failure);
-    }
+      // After the step number (the driver's), in this order.
+      void save(CheckpointOut &ar) const override
+      {
+        ar << dt << dt_lo << dt_hi << next_row << next_field;
+        solver->save(ar);
+        exp->save(ar);
+      }
+      void load(CheckpointIn &ar, unsigned long) override
+      {
+        ar >> dt >> dt_lo >> dt_hi >> next_row >> next_field;
+        solver->load(ar);
+        exp->load(ar);
+        if (ls.field_interval <= 0) // first and last only, whatever the end time now
+          next_field = 2 * ls.end_time;
+      }
+
+    private:
+      LoopSettings                              ls;
+      std::unique_ptr<sph::Solver<dim>>         solver;
+      std::unique_ptr<Experiment<dim>>          exp;
+      std::vector<std::pair<std::string, long>> counts;
+      double dt = 0, dt_lo = std::numeric_limits<double>::infinity(), dt_hi = 0, next_row, next_field;
+    };
 
     /// Mean of @p v over indices in @p rows.
     double mean_of(const std::vector<double> &v, const std::vector<std::size_t> &rows)
@@ -560,17 +513,6 @@ namespace tribo::app
       double area() const { return load_area; }
       unsigned int n_block() const { return n_b; }
       unsigned int n_substrate() const { return n_s; }
-
-      std::vector<std::string> columns() const override
-      {
-        std::vector<std::string> c = {
-          "force_x", "force_normal", "mu", "normal_force_ratio", "drive_force_x", "block_dx",
-          "block_dz", "block_vx", "block_vz", "kinetic_energy_block", "kinetic_energy_substrate",
-          "internal_energy", "work_pressure", "work_drive", "energy_residual"};
-        for (unsigned int r = 0; r < p.regions; ++r)
-          c.push_back("mu_region_" + std::to_string(r));
-        return c;
-      }
 
       /// Lands on the slide start.
       double step_limit(const sph::Solver<dim> &solver) const override
@@ -628,7 +570,7 @@ namespace tribo::app
 
       /// The slider's columns (see columns()): interval means of the contact forces and
       /// the drive, centre-of-mass motion, energies; resets the interval sums.
-      std::vector<double> row(const sph::Solver<dim> &solver) override
+      void row(const sph::Solver<dim> &solver, Row &row) override
       {
         const auto &s = solver.state;
         double      fx = 0, fn = 0;
@@ -659,17 +601,18 @@ namespace tribo::app
         v_cm /= m_b;
         const double ramp     = 1 - std::exp(-solver.time / p.tau);
         const double residual = work_pressure + work_drive - (ke_b + ke_s) - e_int;
-        std::vector<double> r = {fx * w, fn * w, mu_of(fx, fn),
-                                 ramp > 0 ? fn * w / (p.pressure * load_area * ramp) : 0.0,
-                                 drive_impulse * w, dx_cm[0], dx_cm[dim - 1], v_cm[0], v_cm[dim - 1],
-                                 ke_b, ke_s, e_int, work_pressure, work_drive, residual};
+        row("force_x", fx * w)("force_normal", fn * w)("mu", mu_of(fx, fn))
+          ("normal_force_ratio", ramp > 0 ? fn * w / (p.pressure * load_area * ramp) : 0.0)
+          ("drive_force_x", drive_impulse * w)("block_dx", dx_cm[0])("block_dz", dx_cm[dim - 1])
+          ("block_vx", v_cm[0])("block_vz", v_cm[dim - 1])("kinetic_energy_block", ke_b)
+          ("kinetic_energy_substrate", ke_s)("internal_energy", e_int)("work_pressure", work_pressure)
+          ("work_drive", work_drive)("energy_residual", residual);
         for (unsigned int k = 0; k < p.regions; ++k)
-          r.push_back(mu_of(sum_fx[k], sum_fn[k]));
+          row("mu_region_" + std::to_string(k), mu_of(sum_fx[k], sum_fn[k]));
         std::fill(sum_fx.begin(), sum_fx.end(), 0.0);
         std::fill(sum_fn.begin(), sum_fn.end(), 0.0);
         drive_impulse = 0;
         interval      = 0;
-        return r;
       }
 
       /// The window: the last N whole lattice periods a/V of the sliding phase,
@@ -1078,24 +1021,27 @@ namespace tribo::app
       return s;
     }
 
-    /// Builds the slider of @p p (after checking the periodic length against the
-    /// neighbour search's 3 cut-offs) and runs it; returns the exit code.
+    /// The slider of @p p (after checking the periodic length against the neighbour
+    /// search's 3 cut-offs).
     template <int dim>
-    int run_slider(EntryReader &r, const SliderParameters &p, const std::string &dir, Log &log,
-                   const RunOptions &o, RunCheckpoint &checkpoint)
+    std::unique_ptr<Simulation> make_slider(EntryReader &r, const SliderParameters &p, Log &log)
     {
       const double period = std::max(3.0, std::round(p.substrate[0] / p.spacing)) * p.spacing;
       if (p.periodic && period < 3 * 2 * std::max(p.smoothing_ratio, p.range_ratio) * p.spacing *
                                    (p.surface == Surface::incommensurate ? p.ratio : 1.0))
         r.fail(slider_section + "/Substrate size", "a substrate at least 3 cut-offs long when periodic");
-      sph::Solver<dim> solver({p.material}, slider_solver<dim>(p, period));
-      Slider<dim>      slider(p, solver, log);
-      JsonObject       summary;
-      summary.set("case", o.case_file);
-      summary.set("n_block", long(slider.n_block()));
-      summary.set("n_substrate", long(slider.n_substrate()));
-      return run_loop(solver, slider, {"sph_slider", p.end_time, p.statistics_interval, p.field_interval},
-                      r.read, summary, dir, log, o, checkpoint);
+      long n_block = 0, n_substrate = 0;
+      auto sim     = std::make_unique<SphSimulation<dim>>(
+        LoopSettings{"sph_slider", p.end_time, p.statistics_interval, p.field_interval},
+        std::make_unique<sph::Solver<dim>>(std::vector<sph::Material>{p.material}, slider_solver<dim>(p, period)),
+        [&](sph::Solver<dim> &solver) {
+          auto slider = std::make_unique<Slider<dim>>(p, solver, log);
+          n_block     = slider->n_block();
+          n_substrate = slider->n_substrate();
+          return slider;
+        });
+      sim->set_counts({{"n_block", n_block}, {"n_substrate", n_substrate}});
+      return sim;
     }
 
     // ------------------------------------------------------------------------------------
@@ -1157,10 +1103,6 @@ namespace tribo::app
         log(os.str());
       }
 
-      std::vector<std::string> columns() const override
-      {
-        return {"tip_deflection", "tip_velocity", "kinetic_energy", "internal_energy", "total_energy"};
-      }
       void before_step(sph::Solver<2> &) override {}
 
       /// Records the tip deflection (mean over the tip column, m) and velocity (m/s)
@@ -1179,12 +1121,13 @@ namespace tribo::app
         v_prev = v;
       }
 
-      std::vector<double> row(const sph::Solver<2> &solver) override
+      void row(const sph::Solver<2> &solver, Row &row) override
       {
         double w = 0, v = 0;
         tip_state(solver, w, v);
         const double ke = solver.state.kinetic_energy(), ei = solver.state.internal_energy();
-        return {w, v, ke, ei, ke + ei};
+        row("tip_deflection", w)("tip_velocity", v)("kinetic_energy", ke)("internal_energy", ei)
+          ("total_energy", ke + ei);
       }
 
       void summarize(const TimeSeries &stats, double, JsonObject &res) const override
@@ -1229,9 +1172,8 @@ namespace tribo::app
       double t_prev = 0, w_prev = 0, v_prev = 0, t_v0 = 0, t_w0 = 0;
     };
 
-    /// Reads "SPH plate", builds the plate and runs it; returns the exit code.
-    int run_plate(EntryReader &r, const std::string &dir, Log &log, const RunOptions &o,
-                  RunCheckpoint &checkpoint)
+    /// Reads "SPH plate" and builds the plate.
+    std::unique_ptr<Simulation> make_plate(EntryReader &r, Log &log)
     {
       const PlateParameters p = read_plate(r);
       sph::SolverParameters s;
@@ -1239,12 +1181,10 @@ namespace tribo::app
       s.beta    = p.beta;
       s.courant = p.courant;
       s.dt_min  = p.dt_min;
-      sph::Solver<2> solver({p.material}, s);
-      Plate          plate(p, solver, log);
-      JsonObject     summary;
-      summary.set("case", o.case_file);
-      return run_loop<2>(solver, plate, {"sph_plate", p.end_time, p.statistics_interval, p.field_interval},
-                         r.read, summary, dir, log, o, checkpoint);
+      return std::make_unique<SphSimulation<2>>(
+        LoopSettings{"sph_plate", p.end_time, p.statistics_interval, p.field_interval},
+        std::make_unique<sph::Solver<2>>(std::vector<sph::Material>{p.material}, s),
+        [&](sph::Solver<2> &solver) { return std::make_unique<Plate>(p, solver, log); });
     }
   } // namespace
 
@@ -1362,29 +1302,12 @@ namespace tribo::app
       read_slider(r);
   }
 
-  int run_sph_scene(const ParameterFile &file, const std::string &dir, Log &log, const RunOptions &o,
-                    RunCheckpoint &checkpoint)
+  std::unique_ptr<Simulation> make_sph_simulation(const ParameterFile &file, Log &log)
   {
     EntryReader r(file);
-    try
-      {
-        const std::string scene = r.text("Simulation/Scene");
-        if (scene == "sph_plate")
-          return run_plate(r, dir, log, o, checkpoint);
-        const SliderParameters p = read_slider(r);
-        return p.dim == 2 ? run_slider<2>(r, p, dir, log, o, checkpoint)
-                          : run_slider<3>(r, p, dir, log, o, checkpoint);
-      }
-    catch (const InputError &e)
-      {
-        // The directory already holds a "running" summary: mark it.
-        JsonObject summary;
-        summary.set("status", "failed");
-        summary.set("case", o.case_file);
-        summary.set("error", std::string(e.what()));
-        atomic_write((fs::path(dir) / "summary.json").string(), summary.to_string());
-        log(std::string("input error: ") + e.what());
-        throw;
-      }
+    if (r.text("Simulation/Scene") == "sph_plate")
+      return make_plate(r, log);
+    const SliderParameters p = read_slider(r);
+    return p.dim == 2 ? make_slider<2>(r, p, log) : make_slider<3>(r, p, log);
   }
 } // namespace tribo::app

@@ -170,9 +170,10 @@ namespace tribo
   {
     std::vector<std::string> saved;
     ar >> saved;
-    if (saved != names)
+    if (!names.empty() && saved != names)
       throw InputError("checkpoint: its statistics columns differ from this case's "
                        "(another scene or another version of tribo)");
+    names = saved;
     ar >> data;
   }
 } // namespace tribo

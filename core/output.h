@@ -31,7 +31,8 @@ namespace tribo
     std::vector<double> column(const std::string &name) const;
     /// CSV text: a header of the column names, then full-precision rows.
     std::string to_csv() const;
-    /// Checkpoint: the columns and rows so far.
+    /// Checkpoint: the columns and rows so far. A series made without columns takes the
+    /// checkpoint's; one made with columns must have the same.
     void save(CheckpointOut &ar) const;
     void load(CheckpointIn &ar);
 

@@ -1,0 +1,338 @@
+#include "app/nscd_simulation.h"
+
+#include "app/sample_file.h"
+#include "app/scene.h"
+#include "core/output.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <sys/resource.h>
+
+namespace tribo::app
+{
+  namespace
+  {
+    /// Peak resident memory of the process so far, MB (getrusage; Linux reports KiB).
+    double peak_memory_mb()
+    {
+      rusage usage{};
+      getrusage(RUSAGE_SELF, &usage);
+      return usage.ru_maxrss / 1024.0;
+    }
+
+    /// Where the steps' wall time goes, over the steps of this process (since the start
+    /// or the last resumption: not checkpointed), for summary.json "timing".
+    struct StepTiming
+    {
+      unsigned long steps = 0, sweeps = 0, check_passes = 0;
+      double        step = 0, detection = 0, boundary_body = 0, solver = 0;
+      /// Sum over steps of (sweeps + check passes) x contacts: a check pass solves every
+      /// contact's law like a sweep.
+      double contact_updates = 0;
+
+      void add(const dem::StepReport &r)
+      {
+        ++steps;
+        sweeps += r.solver.iterations;
+        check_passes += r.solver.check_passes;
+        step += r.time_step;
+        detection += r.time_detection;
+        boundary_body += r.time_boundary_body;
+        solver += r.time_solver;
+        contact_updates += double(r.solver.iterations + r.solver.check_passes) * r.n_contacts;
+      }
+
+      /// Means per step, s, and the NLGS cost per contact update, ns.
+      JsonObject to_json() const
+      {
+        JsonObject j;
+        const double n = std::max(1ul, steps);
+        j.set("steps", long(steps));
+        j.set("step_mean_s", step / n);
+        j.set("detection_mean_s", detection / n);
+        j.set("boundary_body_mean_s", boundary_body / n);
+        j.set("nlgs_mean_s", solver / n);
+        j.set("other_mean_s", (step - detection - boundary_body - solver) / n);
+        j.set("nlgs_sweeps_mean", double(sweeps) / n);
+        j.set("nlgs_check_passes_mean", double(check_passes) / n);
+        j.set("nlgs_ns_per_contact_update", contact_updates > 0 ? 1e9 * solver / contact_updates : 0.0);
+        return j;
+      }
+    };
+
+    /// What the solver did over the run's steps (checkpointed).
+    struct SolverRecord
+    {
+      unsigned long total_iterations = 0, non_converged = 0, max_iterations = 0;
+      double        worst_overlap = 0, max_residual = 0;
+      /// The law residual (dem/law_residual.h) over the steps, and the active set's work.
+      double        max_law_residual = 0, sum_law_residual = 0, max_gap_violation = 0;
+      unsigned long total_factorizations = 0, fallbacks = 0;
+
+      void add(const dem::StepReport &r)
+      {
+        total_iterations += r.solver.iterations;
+        max_iterations    = std::max<unsigned long>(max_iterations, r.solver.iterations);
+        max_residual      = std::max(max_residual, r.solver.residual);
+        max_law_residual  = std::max(max_law_residual, r.solver.law_residual);
+        sum_law_residual += r.solver.law_residual;
+        max_gap_violation = std::max(max_gap_violation, r.solver.gap_violation);
+        total_factorizations += r.solver.factorizations;
+        fallbacks += r.solver.fell_back ? 1 : 0;
+        worst_overlap = std::max(worst_overlap, r.max_overlap);
+      }
+      void save(CheckpointOut &ar) const
+      {
+        ar << total_iterations << non_converged << max_iterations << worst_overlap << max_residual
+           << max_law_residual << sum_law_residual << max_gap_violation << total_factorizations << fallbacks;
+      }
+      void load(CheckpointIn &ar)
+      {
+        ar >> total_iterations >> non_converged >> max_iterations >> worst_overlap >> max_residual >>
+          max_law_residual >> sum_law_residual >> max_gap_violation >> total_factorizations >> fallbacks;
+      }
+    };
+
+    /// Rigid discs stepped by Moreau-Jean: the scene builds them and measures its columns.
+    class NscdSimulation : public Simulation
+    {
+    public:
+      NscdSimulation(const CaseParameters &p, Log &log)
+        : prm(p)
+      {
+        const auto wall_start = std::chrono::steady_clock::now();
+        scene = make_scene(p);
+        scene->build(system);
+        h                     = scene->time_step(system);
+        const double distance = p.detection_distance > 0 ? p.detection_distance : 0.1 * system.min_radius();
+        dem::SolverParameters solver = p.solver;
+        solver.gap_tolerance         = p.gap_tolerance * system.min_radius();
+        mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
+        scene->attach(*mj);
+        n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
+        // A run that goes on from an initial state starts at its step (a whole number of
+        // steps, checked with the parameters).
+        start = std::lround(p.start_time / h);
+        step  = start;
+
+        std::ostringstream os;
+        os << "scene " << p.scene << ": " << system.bodies.size() << " bodies, " << system.discs.size()
+           << " discs; h = " << h << " s, " << n_steps << " steps, detection distance "
+           << mj->detection_distance() << " m";
+        log(os.str());
+        if (!scene->description().empty())
+          log(scene->description());
+        if (start > 0)
+          {
+            std::ostringstream state;
+            state << "starting from the state of " << p.shear.initial_state << " at t = " << start * h
+                  << " s (step " << start << "; its sample_final.csv, without contact impulses)";
+            log(state.str());
+          }
+        if (p.solver.method != dem::SolverParameters::Method::nlgs && p.law.friction > 0)
+          log("Solver/Method = " + dem::method_name(p.solver.method) +
+              " solves frictionless problems only: with Coulomb friction (mu = " +
+              std::to_string(p.law.friction) + ") every step uses NLGS");
+        // What building the case cost: the modules a case does not use are not built (a
+        // rigid wall builds no deal.II, SPH or MLP object).
+        setup_time   = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+        setup_memory = peak_memory_mb();
+        std::ostringstream cost;
+        cost << "set-up " << setup_time << " s, peak memory " << setup_memory << " MB";
+        log(cost.str());
+      }
+
+      unsigned long first_step() const override { return start; }
+      double        time() const override { return step * h; }
+      double        end_time() const override { return n_steps * h; }
+      bool          reached_end(unsigned long s) const override { return s >= n_steps; }
+      bool          finished() const override { return scene->finished(); }
+
+      void advance(unsigned long s, const std::function<void(const std::string &)> &warn) override
+      {
+        scene->before_step(system, s);
+        const dem::StepReport r = mj->step(system, h);
+        step                    = s + 1;
+        record.add(r);
+        timing.add(r);
+        if (!r.solver.converged && ++record.non_converged <= 10)
+          {
+            std::ostringstream os;
+            os << "warning: step " << step << " (t = " << time() << " s): NLGS did not converge in "
+               << r.solver.iterations << " sweeps, residual " << r.solver.residual
+               << (record.non_converged == 10 ? " (further warnings only counted)" : "");
+            warn(os.str());
+          }
+        last = Row();
+        last("n_contacts", r.n_contacts)("n_active_contacts", r.n_active)
+          ("nlgs_iterations", r.solver.iterations)("nlgs_residual", r.solver.residual)
+          ("nlgs_converged", r.solver.converged ? 1.0 : 0.0)("law_residual", r.solver.law_residual)
+          ("gap_violation", r.solver.gap_violation)("epsilon", r.epsilon)("max_overlap", r.max_overlap)
+          ("kinetic_energy", r.kinetic_energy)("power_external", r.power_external)
+          ("power_free", r.power_free)("power_contacts", r.power_contacts);
+        scene->measure(system, *mj, r, last);
+        measured = true;
+      }
+
+      bool row(Row &row) override
+      {
+        for (const auto &[name, value] : last.columns())
+          row(name, value);
+        return measured;
+      }
+      bool row_due(unsigned long s) override { return s % prm.statistics_interval == 0; }
+      bool snapshot_due(unsigned long s) override
+      {
+        return prm.field_interval > 0 && s % prm.field_interval == 0;
+      }
+
+      void write_snapshot(FieldWriter &writer) override
+      {
+        const auto &s = system;
+        DiscField   discs;
+        for (std::size_t d = 0; d < s.discs.size(); ++d)
+          {
+            const auto &b   = s.bodies[s.discs[d].body];
+            const auto  x   = s.wrap(s.disc_centre(d));
+            const auto  arm = dem::rotate(s.discs[d].offset, b.angle);
+            discs.x.push_back(x.x());
+            discs.y.push_back(x.y());
+            discs.radius.push_back(s.discs[d].radius);
+            discs.vx.push_back(b.velocity.x() - b.spin * arm.y());
+            discs.vy.push_back(b.velocity.y() + b.spin * arm.x());
+            discs.spin.push_back(b.spin);
+            discs.body.push_back(s.discs[d].body);
+          }
+        ContactField contacts;
+        for (const auto &c : mj->contacts())
+          {
+            if (c.r.x() == 0 && c.r.y() == 0)
+              continue;
+            const auto x0 = s.wrap(s.disc_centre(c.disc[0]));
+            contacts.x0.push_back(x0.x());
+            contacts.y0.push_back(x0.y());
+            contacts.x1.push_back(x0.x() + c.branch.x());
+            contacts.y1.push_back(x0.y() + c.branch.y());
+            contacts.normal_force.push_back(c.r.x() / h);
+            contacts.tangential_force.push_back(c.r.y() / h);
+            contacts.gap.push_back(c.gap);
+          }
+        writer.write(time(), discs, contacts);
+        // The discs as a sample file next to the snapshot (`tribo sample DIR --time T`),
+        // exact where the VTU's Float32 is not.
+        if (const std::string sample = scene->sample(s); !sample.empty())
+          atomic_write(sample_snapshot_path(writer.directory(), writer.n_snapshots() - 1), sample);
+        // The scene's own fields, SERIES_NNNNN.vtu, indexed in SERIES.pvd.
+        for (const std::string &file : scene->write_fields(writer.directory(), writer.n_snapshots() - 1))
+          writer.index(file.substr(0, file.rfind('_')), time(), file);
+      }
+      unsigned int n_snapshots(const FieldWriter &fields) const override { return fields.n_snapshots(); }
+
+      std::string resumed_line(unsigned long s) const override
+      {
+        std::ostringstream os;
+        os << "resumed at step " << s << " (t = " << time() << " s) of " << n_steps;
+        return os.str();
+      }
+
+      void summarize(const RunEnd &end, JsonObject &summary, RunOutputs &out) override
+      {
+        const unsigned long steps_run = step - start;
+        const auto          per_step  = [&](double total) { return steps_run ? total / steps_run : 0.0; };
+        const auto          method    = prm.solver.method;
+        summary.set("time_step", h);
+        summary.set("steps_planned", long(n_steps - start));
+        summary.set("start_time", start * h);
+        summary.set("nlgs_iterations_total", long(record.total_iterations));
+        summary.set("nlgs_iterations_mean", per_step(record.total_iterations));
+        summary.set("nlgs_iterations_max", long(record.max_iterations));
+        summary.set("nlgs_residual_max", record.max_residual);
+        summary.set("nlgs_non_converged_steps", long(record.non_converged));
+        summary.set("law_residual_max", record.max_law_residual);
+        summary.set("law_residual_mean", per_step(record.sum_law_residual));
+        summary.set("gap_violation_max", record.max_gap_violation);
+        summary.set("solver_method", dem::method_name(method));
+        summary.set("factorizations_mean", per_step(record.total_factorizations));
+        summary.set("active_set_fallbacks", long(record.fallbacks));
+        summary.set("max_overlap", record.worst_overlap);
+        summary.set("max_overlap_over_min_radius", record.worst_overlap / system.min_radius());
+        summary.set("n_bodies", long(system.bodies.size()));
+        summary.set("n_discs", long(system.discs.size()));
+        summary.set("timing", timing.to_json());
+        summary.set("setup_time", setup_time);
+        summary.set("setup_peak_memory", setup_memory);
+        summary.set("peak_memory", peak_memory_mb());
+        if (!end.statistics.rows().empty())
+          {
+            scene->summarize(system, end.statistics, out.results);
+            if (const std::string note = scene->averaging_note(); !note.empty())
+              end.log(note);
+          }
+        out.scalars["time_step"] = h;
+        out.tables               = scene->tables();
+        out.final_sample         = scene->sample(system);
+        if (prm.plots && prm.scene == "shear")
+          out.plot_script = "plot_run.py";
+
+        std::ostringstream os;
+        os << steps_run << " steps in " << end.wall_time << " s, " << per_step(record.total_iterations)
+           << (method == dem::SolverParameters::Method::mprgp ? " NLGS sweeps and MPRGP products" : " NLGS sweeps")
+           << " per step, " << record.non_converged << " steps not converged, law residual mean "
+           << per_step(record.sum_law_residual) << " max " << record.max_law_residual << ", worst overlap "
+           << record.worst_overlap << " m";
+        if (method == dem::SolverParameters::Method::active_set ||
+            method == dem::SolverParameters::Method::interior_point)
+          os << ", " << per_step(record.total_factorizations) << " factorisations per step";
+        if (method == dem::SolverParameters::Method::active_set)
+          os << ", " << record.fallbacks << " NLGS fallbacks";
+        if (timing.steps > 0)
+          {
+            const double n = timing.steps;
+            os << "; per step " << 1e3 * timing.step / n << " ms: solver " << 1e3 * timing.solver / n
+               << " ms, detection " << 1e3 * timing.detection / n << " ms, upper body "
+               << 1e3 * timing.boundary_body / n << " ms";
+          }
+        out.last_line = os.str();
+      }
+
+      // After the step number (the driver's): the solver's record, then every object's
+      // state, in this order.
+      void save(CheckpointOut &ar) const override
+      {
+        record.save(ar);
+        system.save(ar);
+        mj->save(ar);
+        scene->save(ar);
+      }
+      void load(CheckpointIn &ar, unsigned long s) override
+      {
+        step = s;
+        record.load(ar);
+        system.load(ar);
+        mj->load(ar);
+        scene->load(ar);
+      }
+
+    private:
+      CaseParameters                   prm;
+      std::unique_ptr<Scene>           scene;
+      dem::ParticleSystem              system;
+      std::unique_ptr<dem::MoreauJean> mj;
+      double                           h = 0;
+      unsigned long                    n_steps = 0, start = 0, step = 0;
+      double                           setup_time = 0, setup_memory = 0;
+      SolverRecord                     record;
+      StepTiming                       timing; ///< the steps since the start or the last resumption
+      Row                              last;   ///< the columns measured after the last step
+      bool                             measured = false;
+    };
+  } // namespace
+
+  std::unique_ptr<Simulation> make_nscd_simulation(const CaseParameters &p, Log &log)
+  {
+    return std::make_unique<NscdSimulation>(p, log);
+  }
+} // namespace tribo::app

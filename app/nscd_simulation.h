@@ -1,0 +1,15 @@
+#pragma once
+/// @file The scenes of rigid discs (collision, shear): an app::Scene stepped by the
+/// Moreau-Jean integrator, as the driver (app/driver.h) runs it.
+
+#include "app/case_parameters.h"
+#include "app/driver.h"
+
+#include <memory>
+
+namespace tribo::app
+{
+  /// The NSCD simulation of the case @p p (Simulation/Scene collision or shear): builds the
+  /// scene, its bodies and the integrator, and logs what was built and what it cost.
+  std::unique_ptr<Simulation> make_nscd_simulation(const CaseParameters &p, Log &log);
+} // namespace tribo::app

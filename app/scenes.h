@@ -1,0 +1,55 @@
+#pragma once
+/// @file The scenes of `tribo run` (Simulation/Scene): one table, in app/scenes.cc, of every
+/// scene's name, description, parameter declarations, check and factory. The Selection of
+/// Simulation/Scene, its documentation in `tribo params` and run_case()'s choice of what
+/// to build all come from it; a scene whose module the build left out keeps its row, so
+/// that a case naming it is refused with the build option it needs.
+
+#include "app/driver.h"
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tribo
+{
+  class ParameterFile; // core/parameter_file.h
+}
+
+namespace tribo::app
+{
+  struct CaseParameters; // app/case_parameters.h
+
+  struct SceneEntry
+  {
+    std::string name;        ///< the value of Simulation/Scene
+    std::string description; ///< for Simulation/Scene's documentation
+    /// The CMake option that builds the scene's module, "" for the NSCD scenes (always
+    /// built).
+    std::string build_option;
+    /// Declares the scene's own subsections (shared by the scenes of one module: each
+    /// distinct function is called once); nullptr: none beyond the NSCD subsections.
+    void (*declare)(dealii::ParameterHandler &) = nullptr;
+    /// Reads and checks the scene's own entries without building it (InputError naming
+    /// the entry), before anything is written; nullptr: read_case_parameters() did.
+    void (*check)(const ParameterFile &) = nullptr;
+    /// Builds the scene (what it built goes to the log); nullptr: not in this build.
+    std::unique_ptr<Simulation> (*make)(const ParameterFile &, const CaseParameters &, Log &) = nullptr;
+  };
+
+  /// Every scene of the program, built or not, in the order of Simulation/Scene's
+  /// Selection.
+  const std::vector<SceneEntry> &scenes();
+
+  /// The scene @p name (a value Simulation/Scene's Selection allowed).
+  const SceneEntry &scene_named(const std::string &name);
+
+  /// Declare the entry Scene (Selection and documentation from scenes()) in the current
+  /// subsection (Simulation).
+  void declare_scene_entry(dealii::ParameterHandler &prm);
+
+  /// Declare every built scene's own subsections (each module's once).
+  void declare_scene_subsections(dealii::ParameterHandler &prm);
+} // namespace tribo::app
