@@ -82,9 +82,10 @@ namespace tribo::app
     double      start_time = 0;
     double      theta;
     dem::ContactLaw     law;
-    double              detection_distance; ///< m; 0: a tenth of the smallest radius
+    double              detection_distance; ///< m; 0: a tenth of the smallest radius (law.detection_distance)
     dem::SolverParameters solver;
-    double              gap_tolerance; ///< Solver/Gap tolerance, fraction of the smallest radius
+    /// Solver/Gap tolerance, fraction of the smallest radius (solver.relative_gap_tolerance)
+    double              gap_tolerance;
     unsigned int statistics_interval; ///< steps between rows of statistics.csv
     unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)
     bool         plots;               ///< PNG plots of a shear run (scripts/plot_run.py)
