@@ -58,6 +58,36 @@ namespace tribo::app
       p.start_time = std::round(steps) * p.time_step;
       sc.sample    = read_sample((dir / "sample_final.csv").string(), sc.length);
     }
+
+    /// The upper first body of the shear cell @p p: its own entries, read by coupling,
+    /// and the cell's geometry, load and time step; checked as a whole unless rigid.
+    coupling::FirstBodyParameters upper_body_parameters(const ParameterFile &f, const CaseParameters &p)
+    {
+      const auto                   &sc = p.shear;
+      coupling::FirstBodyParameters b  = coupling::FirstBodyParameters::parse(f, "Shear cell");
+      b.length             = sc.length;
+      b.thickness          = sc.upper_body_thickness;
+      b.density            = sc.density;
+      if (b.resolution == 0)
+        b.resolution = sc.mean_diameter * (1 - sc.diameter_spread);
+      b.theta              = p.theta;
+      b.time_step          = p.time_step;
+      b.time_step_entry    = "Simulation/Time step";
+      b.pressure           = sc.pressure;
+      b.pressure_ramp_time = sc.ramp_time;
+      if (sc.shear_start == 0)
+        b.compaction_damping = 0; // no compaction phase
+      if (b.model != "rigid")
+        try
+          {
+            coupling::check_first_body(b);
+          }
+        catch (const InputError &e)
+          {
+            throw InputError(f.filename() + ": " + e.what());
+          }
+      return b;
+    }
   } // namespace
 
   void declare_case_parameters(dealii::ParameterHandler &prm)
@@ -174,45 +204,7 @@ namespace tribo::app
                       "must be the run's. A relative path is relative to the case file. Not with "
                       "Sample file. A deformable Upper body model takes the upper wall's place, unloaded, and "
                       "takes the load over Pressure ramp time from t0 (docs/outputs.md, 'Initial states').");
-    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
-                      "rigid: a rough wall of discs with the mass of the first body (the paper's "
-                      "classical model); fem: a plane-strain elastic body of that thickness "
-                      "(deal.II), touched through half-disc elements (the paper's hybrid model); reduced: "
-                      "that body condensed onto its contact nodes plus Upper body modes vibration modes "
-                      "(Craig-Bampton), cheaper than fem, exact in the static limit; "
-                      "sph, mlp: the same body as an SPH (square lattice) or movable-lattice-particle "
-                      "(hexagonal lattice) block whose bottom row of particles carries the half-discs, "
-                      "sub-cycled inside each contact step (docs/first_bodies.md).");
-    prm.declare_entry("Upper body Young's modulus", "1e11", Double(),
-                      "E of the deformable upper body, Pa (> 0; paper: 1e11 and 3e9).");
-    prm.declare_entry("Upper body Poisson ratio", "0.33", Double(),
-                      "nu of the deformable upper body, plane strain (in (-1, 0.5); paper: 0.33; "
-                      "mlp: at most 0.25).");
-    prm.declare_entry("Upper body cell size", "0", Double(),
-                      "Cell size of the fem upper body's mesh, or particle spacing of the sph and mlp "
-                      "bodies, m (>= 0); 0: the smallest grain diameter d(1-s), the paper's choice.");
-    prm.declare_entry("Upper body smoothing length ratio", "1.2", Double(),
-                      "Smoothing length over particle spacing of the sph upper body (in [1, 2]).");
-    prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
-                      "Degree p of the fem upper body's Q_p elements.");
-    prm.declare_entry("Upper body modes", "20", Integer(0),
-                      "Fixed-interface vibration modes kept by the reduced upper body (>= 0; 0: static "
-                      "condensation plus the load mode only), docs/fem.md.");
-    prm.declare_entry("Upper body mass damping", "0", Double(),
-                      "Rayleigh coefficient a of C = a M + b K for the fem upper body, 1/s (>= 0).");
-    prm.declare_entry("Upper body stiffness damping", "0", Double(),
-                      "Rayleigh coefficient b of C = a M + b K for the fem upper body, s (>= 0).");
-    prm.declare_entry("Half-disc diameter", "0", Double(),
-                      "Diameter of the half-disc contact elements on the fem upper body, m (>= 0); "
-                      "0: the cell size (one per boundary edge, the paper's choice).");
-    prm.declare_entry("Upper body compaction damping", "1", Double(),
-                      "Damping ratio zeta (>= 0) of the deformable upper body's first thickness mode, "
-                      "omega_1 = pi c_p / (2 H), added before Shear start as damping of the velocity "
-                      "towards rest at gamma = 2 zeta omega_1 (fem: mass-proportional Rayleigh damping) "
-                      "and removed when shearing starts: the body then lands on the layer at the "
-                      "terminal speed P / (rho H gamma) (0.7 m/s for the paper's steel body) instead of "
-                      "falling freely onto it, and does not ring (no numerical damping at theta = 0.5). "
-                      "The rigid wall's Compaction speed limit plays this part. 0: off.");
+    coupling::FirstBodyParameters::declare(prm);
     prm.leave_subsection();
   }
 
@@ -284,7 +276,6 @@ namespace tribo::app
         sc.profile_samples = f.get_integer(S + "Profile samples");
         sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");
         sc.seed = f.get_integer(S + "Seed");
-        sc.upper_body_model = f.get(S + "Upper body model");
         if (const std::string sample = f.get(S + "Sample file"); !sample.empty())
           {
             const std::filesystem::path given(sample);
@@ -296,53 +287,9 @@ namespace tribo::app
           }
         if (const std::string state = f.get(S + "Initial state"); !state.empty())
           read_initial_state(f, state, p);
-        sc.sph_smoothing_ratio = f.get_checked(S + "Upper body smoothing length ratio",
-                                               [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
-        sc.upper_youngs_modulus = f.get_checked(S + "Upper body Young's modulus", positive, "a positive modulus in Pa");
-        sc.upper_poisson_ratio = f.get_checked(S + "Upper body Poisson ratio", [](double v) { return v > -1 && v < 0.5; },
-                                               "a Poisson ratio in (-1, 0.5)");
-        sc.upper_cell_size = f.get_checked(S + "Upper body cell size", non_negative, "a size >= 0 in m");
-        sc.upper_degree = f.get_integer(S + "Upper body element degree");
-        sc.upper_modes  = f.get_integer(S + "Upper body modes");
-        sc.upper_mass_damping = f.get_checked(S + "Upper body mass damping", non_negative, "a coefficient >= 0 in 1/s");
-        sc.upper_stiffness_damping = f.get_checked(S + "Upper body stiffness damping", non_negative, "a coefficient >= 0 in s");
-        sc.half_disc_diameter = f.get_checked(S + "Half-disc diameter", non_negative, "a diameter >= 0 in m");
-        sc.upper_compaction_damping = f.get_checked(S + "Upper body compaction damping", non_negative, "a damping ratio >= 0");
-        if (sc.upper_body_model != "rigid")
-          try
-            {
-              coupling::check_first_body(first_body_parameters(p));
-            }
-          catch (const InputError &e)
-            {
-              throw InputError(f.filename() + ": " + e.what());
-            }
+        sc.upper_body = upper_body_parameters(f, p);
       }
     return p;
-  }
-
-  coupling::FirstBodyParameters first_body_parameters(const CaseParameters &p)
-  {
-    const auto                   &k = p.shear;
-    coupling::FirstBodyParameters b;
-    b.model              = k.upper_body_model;
-    b.length             = k.length;
-    b.thickness          = k.upper_body_thickness;
-    b.youngs_modulus     = k.upper_youngs_modulus;
-    b.poisson_ratio      = k.upper_poisson_ratio;
-    b.density            = k.density;
-    b.resolution         = k.upper_cell_size > 0 ? k.upper_cell_size : k.mean_diameter * (1 - k.diameter_spread);
-    b.degree             = k.upper_degree;
-    b.modes              = k.upper_modes;
-    b.rayleigh_mass      = k.upper_mass_damping;
-    b.rayleigh_stiffness = k.upper_stiffness_damping;
-    b.theta              = p.theta;
-    b.time_step          = p.time_step;
-    b.pressure           = k.pressure;
-    b.pressure_ramp_time = k.ramp_time;
-    b.compaction_damping = k.shear_start > 0 ? k.upper_compaction_damping : 0.0;
-    b.smoothing_ratio    = k.sph_smoothing_ratio;
-    return b;
   }
 
   RunRecord read_run_record(const std::string &dir)
