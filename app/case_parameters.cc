@@ -58,6 +58,36 @@ namespace tribo::app
       p.start_time = std::round(steps) * p.time_step;
       sc.sample    = read_sample((dir / "sample_final.csv").string(), sc.length);
     }
+
+    /// The upper first body of the shear cell @p p: its own entries, read by coupling,
+    /// and the cell's geometry, load and time step; checked as a whole unless rigid.
+    coupling::FirstBodyParameters upper_body_parameters(const ParameterFile &f, const CaseParameters &p)
+    {
+      const auto                   &sc = p.shear;
+      coupling::FirstBodyParameters b  = coupling::FirstBodyParameters::parse(f, "Shear cell");
+      b.length             = sc.length;
+      b.thickness          = sc.upper_body_thickness;
+      b.density            = sc.density;
+      if (b.resolution == 0)
+        b.resolution = sc.mean_diameter * (1 - sc.diameter_spread);
+      b.theta              = p.theta;
+      b.time_step          = p.time_step;
+      b.time_step_entry    = "Simulation/Time step";
+      b.pressure           = sc.pressure;
+      b.pressure_ramp_time = sc.ramp_time;
+      if (sc.shear_start == 0)
+        b.compaction_damping = 0; // no compaction phase
+      if (b.model != "rigid")
+        try
+          {
+            coupling::check_first_body(b);
+          }
+        catch (const InputError &e)
+          {
+            throw InputError(f.filename() + ": " + e.what());
+          }
+      return b;
+    }
   } // namespace
 
   void declare_case_parameters(dealii::ParameterHandler &prm)
@@ -72,87 +102,11 @@ declare_scene_subsections(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Contact law");
-    prm.declare_entry("Law", "IQS", Selection("IQS|ELAS"),
-                      "IQS: cohesive unilateral (inelastic quasi-shock), r_N + gamma >= 0, g >= 0, "
-                      "(r_N + gamma) g = 0. ELAS: cohesive elastic, r_N + gamma = max(0, -k g). "
-                      "r_N > 0 is compressive; see docs/laws.md.");
-    prm.declare_entry("Cohesion", "0", Double(), "Cohesion gamma, N/m (force per unit depth), >= 0.");
-    prm.declare_entry("Cohesion range", "0", Double(),
-                      "Distance d_w over which the cohesion acts, m, >= 0 (needed if Cohesion > 0).");
-    prm.declare_entry("Stiffness", "1e10", Double(),
-                      "ELAS normal stiffness k, N/m^2 (force per unit depth per metre of overlap), > 0.");
-    prm.declare_entry("Friction coefficient", "0", Double(),
-                      "Coulomb friction coefficient between discs, >= 0 (0: frictionless, as in the paper).");
-    prm.declare_entry("Overlap recovery", "0", Double(0, 1),
-                      "IQS only: fraction in [0, 1] of an existing overlap pushed out per step. 0 freezes "
-                      "overlaps as the paper's law does; under high pressure the NLGS's small velocity "
-                      "errors then accumulate into overlaps step after step (docs/laws.md); 0.1 keeps "
-                      "them at the size of one step's error.");
-    prm.declare_entry("Detection distance", "0", Double(),
-                      "Pairs closer than this gap (m) enter the contact list; 0 picks a tenth of the "
-                      "smallest radius. Always at least the cohesion range.");
+    dem::ContactLaw::declare(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Solver");
-    prm.declare_entry("Method", "nlgs", Selection("nlgs|active-set|mprgp|interior-point"),
-                      "Contact solver: 'nlgs' (nonlinear Gauss-Seidel, the entries below), "
-                      "'active-set' (projected Newton method on the frictionless problem, the "
-                      "sparse Delassus operator factorised by CHOLMOD) or 'mprgp' (matrix-free "
-                      "projected conjugate gradient with proportioning, on both cores with "
-                      "Threads = 2) or 'interior-point' (Mehrotra's predictor-corrector, CHOLMOD: "
-                      "the one that reaches 1e-8 on dense packings). The last three stop at "
-                      "Residual target; with friction their steps use NLGS and the log says so. "
-                      "docs/performance.md compares them.");
-    prm.declare_entry("Residual target", "1e-3", Double(),
-                      "Active set, MPRGP, interior point: the solve ends when the law residual, max over "
-                      "contacts of |min(r~, u~ / W_nn)| over the mean loaded impulse r~ "
-                      "(dimensionless, docs/laws.md), is below this, in (0, 1). The default is "
-                      "below the 1.2-1.5e-3 NLGS leaves on average at its default Tolerance (1e-4, "
-                      "Quad) in steady shear, where MPRGP at 1.5e-3 let overlaps grow past a radius "
-                      "(docs/performance.md); 1e-11 is a converged solve.");
-    prm.declare_entry("Regularization", "1e-8", Double(),
-                      "Active set: relative regularisation delta in [0, 1e-4] of the Newton matrix "
-                      "W_FF + delta diag(W_FF) (redundant contacts make W_FF singular); it changes "
-                      "the Newton step, not the solution.");
-    prm.declare_entry("Predictor sweeps", "10", Integer(0),
-                      "Active set, MPRGP, interior point: NLGS sweeps before their iterations, >= 0 "
-                      "(0 suits the interior point).");
-    prm.declare_entry("Maximum factorizations", "50", Integer(1),
-                      "Active set: Newton iterations (factorisations) per step before the step is "
-                      "solved by NLGS instead; interior point: iterations before it stops, not "
-                      "converged, >= 1.");
-    prm.declare_entry("Tolerance", "1e-4", Double(), "NLGS tolerance, > 0 (relative, see Norm).");
-    prm.declare_entry("Norm", "Quad", Selection("Quad|Maxm"),
-                      "Convergence norm of the established NSCD code: 'Quad' (mean-square) or "
-                      "'Maxm' (maximum over contacts).");
-    prm.declare_entry("Relaxation", "1", Double(), "Relaxation omega in (0, 1]: r = omega r_law + (1 - omega) r_old.");
-    prm.declare_entry("Check interval", "10", Integer(1), "Sweeps between convergence checks, >= 1.");
-    prm.declare_entry("Maximum iterations", "10000", Integer(1),
-                      "Maximum number of sweeps per step (MPRGP: products with the Delassus "
-                      "operator), >= 1.");
-    prm.declare_entry("Contact order", "fixed", Selection("fixed|alternating|random"),
-                      "Order of the local solves: 'fixed' (detection order: cells by rows, bottom to "
-                      "top), 'alternating' (that order and its reverse in turn, a symmetric Gauss-Seidel) "
-                      "or 'random' (shuffled every sweep).");
-    prm.declare_entry("Seed", "1", Integer(0), "Seed of the random contact order.");
-    prm.declare_entry("Streams", "1", Integer(1),
-                      "With Contact order = fixed: windows of 64 x Streams consecutive contacts, "
-                      "each cut into this many streams solved one contact from each in turn, >= 1 "
-                      "(1: the detection order itself). Contacts 64 apart rarely share a body, so "
-                      "the processor overlaps their updates: 4 streams do 1.2-1.5 times more contact "
-                      "updates per second for about 3 % more sweeps, and change the trajectory "
-                      "(docs/performance.md).");
-    prm.declare_entry("Threads", "1", Integer(1),
-                      "Bands of contacts solved at once, >= 1 (1: the serial sweep). T > 1 cuts the "
-                      "contacts (rows of cells, bottom to top) into 2T bands and solves the even bands "
-                      "concurrently, then the odd ones: a Gauss-Seidel sweep in that band order, the "
-                      "same result on any number of cores. Needs Contact order = fixed. The contact "
-                      "detection also runs in T threads (the same contacts whatever T).");
-    prm.declare_entry("Gap tolerance", "0", Double(),
-                      "Extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
-                      "0: off, the established code's norms only): every contact's gap violation "
-                      "theta h max(0, -(u_n + shift)) must be below it. Limits the overlaps that the "
-                      "norms let accumulate under high pressure, at the price of more sweeps.");
+    dem::SolverParameters::declare(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Output");
@@ -237,45 +191,7 @@ declare_scene_subsections(prm);
                       "must be the run's. A relative path is relative to the case file. Not with "
                       "Sample file. A deformable Upper body model takes the upper wall's place, unloaded, and "
                       "takes the load over Pressure ramp time from t0 (docs/outputs.md, 'Initial states').");
-    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
-                      "rigid: a rough wall of discs with the mass of the first body (the paper's "
-                      "classical model); fem: a plane-strain elastic body of that thickness "
-                      "(deal.II), touched through half-disc elements (the paper's hybrid model); reduced: "
-                      "that body condensed onto its contact nodes plus Upper body modes vibration modes "
-                      "(Craig-Bampton), cheaper than fem, exact in the static limit; "
-                      "sph, mlp: the same body as an SPH (square lattice) or movable-lattice-particle "
-                      "(hexagonal lattice) block whose bottom row of particles carries the half-discs, "
-                      "sub-cycled inside each contact step (docs/first_bodies.md).");
-    prm.declare_entry("Upper body Young's modulus", "1e11", Double(),
-                      "E of the deformable upper body, Pa (> 0; paper: 1e11 and 3e9).");
-    prm.declare_entry("Upper body Poisson ratio", "0.33", Double(),
-                      "nu of the deformable upper body, plane strain (in (-1, 0.5); paper: 0.33; "
-                      "mlp: at most 0.25).");
-    prm.declare_entry("Upper body cell size", "0", Double(),
-                      "Cell size of the fem upper body's mesh, or particle spacing of the sph and mlp "
-                      "bodies, m (>= 0); 0: the smallest grain diameter d(1-s), the paper's choice.");
-    prm.declare_entry("Upper body smoothing length ratio", "1.2", Double(),
-                      "Smoothing length over particle spacing of the sph upper body (in [1, 2]).");
-    prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
-                      "Degree p of the fem upper body's Q_p elements.");
-    prm.declare_entry("Upper body modes", "20", Integer(0),
-                      "Fixed-interface vibration modes kept by the reduced upper body (>= 0; 0: static "
-                      "condensation plus the load mode only), docs/fem.md.");
-    prm.declare_entry("Upper body mass damping", "0", Double(),
-                      "Rayleigh coefficient a of C = a M + b K for the fem upper body, 1/s (>= 0).");
-    prm.declare_entry("Upper body stiffness damping", "0", Double(),
-                      "Rayleigh coefficient b of C = a M + b K for the fem upper body, s (>= 0).");
-    prm.declare_entry("Half-disc diameter", "0", Double(),
-                      "Diameter of the half-disc contact elements on the fem upper body, m (>= 0); "
-                      "0: the cell size (one per boundary edge, the paper's choice).");
-    prm.declare_entry("Upper body compaction damping", "1", Double(),
-                      "Damping ratio zeta (>= 0) of the deformable upper body's first thickness mode, "
-                      "omega_1 = pi c_p / (2 H), added before Shear start as damping of the velocity "
-                      "towards rest at gamma = 2 zeta omega_1 (fem: mass-proportional Rayleigh damping) "
-                      "and removed when shearing starts: the body then lands on the layer at the "
-                      "terminal speed P / (rho H gamma) (0.7 m/s for the paper's steel body) instead of "
-                      "falling freely onto it, and does not ring (no numerical damping at theta = 0.5). "
-                      "The rigid wall's Compaction speed limit plays this part. 0: off.");
+    coupling::FirstBodyParameters::declare(prm);
     prm.leave_subsection();
   }
 
@@ -290,46 +206,8 @@ declare_scene_subsections(prm);
     p.end_time  = f.get_checked("Simulation/End time", positive, "a positive end time in s");
     p.theta     = f.get_double("Simulation/Theta");
 
-    p.law.type = f.get("Contact law/Law") == "IQS" ? dem::ContactLaw::Type::iqs : dem::ContactLaw::Type::elas;
-    p.law.cohesion = f.get_checked("Contact law/Cohesion", non_negative, "a cohesion >= 0 in N/m");
-    p.law.cohesion_range =
-      f.get_checked("Contact law/Cohesion range", non_negative, "a distance >= 0 in m");
-    if (p.law.cohesion > 0 && p.law.cohesion_range == 0)
-      f.fail("Contact law/Cohesion range", "a positive range in m, since Contact law/Cohesion > 0");
-    p.law.stiffness = f.get_checked("Contact law/Stiffness", positive, "a positive stiffness in N/m^2");
-    p.law.overlap_recovery = f.get_double("Contact law/Overlap recovery");
-    p.law.friction  = f.get_checked("Contact law/Friction coefficient", non_negative, "a coefficient >= 0");
-    p.detection_distance =
-      f.get_checked("Contact law/Detection distance", non_negative, "a distance >= 0 in m");
-
-    const std::string method = f.get("Solver/Method");
-    p.solver.method = method == "active-set" ? dem::SolverParameters::Method::active_set
-                      : method == "mprgp"    ? dem::SolverParameters::Method::mprgp
-                      : method == "interior-point" ? dem::SolverParameters::Method::interior_point
-                                             : dem::SolverParameters::Method::nlgs;
-    p.solver.residual_target = f.get_checked("Solver/Residual target", [](double v) { return v > 0 && v < 1; },
-                                             "a relative residual in (0, 1)");
-    p.solver.regularization = f.get_checked("Solver/Regularization", [](double v) { return v >= 0 && v <= 1e-4; },
-                                            "a regularisation in [0, 1e-4]");
-    p.solver.max_factorizations = f.get_integer("Solver/Maximum factorizations");
-    p.solver.predictor_sweeps   = f.get_integer("Solver/Predictor sweeps");
-    p.solver.tolerance = f.get_checked("Solver/Tolerance", positive, "a positive tolerance");
-    p.solver.norm = f.get("Solver/Norm") == "Quad" ? dem::SolverParameters::Norm::quad : dem::SolverParameters::Norm::maxm;
-    p.solver.relaxation = f.get_checked("Solver/Relaxation", [](double v) { return v > 0 && v <= 1; },
-                                        "a relaxation in (0, 1]");
-    p.solver.check_interval = f.get_integer("Solver/Check interval");
-    p.solver.max_iterations = f.get_integer("Solver/Maximum iterations");
-    const std::string order = f.get("Solver/Contact order");
-    p.solver.order = order == "random"        ? dem::SolverParameters::Order::random
-                     : order == "alternating" ? dem::SolverParameters::Order::alternating
-                                              : dem::SolverParameters::Order::fixed;
-    p.solver.seed           = f.get_integer("Solver/Seed");
-    p.solver.threads        = f.get_integer("Solver/Threads");
-    p.solver.streams        = f.get_integer("Solver/Streams");
-    if (p.solver.threads > 1 && p.solver.order != dem::SolverParameters::Order::fixed)
-      f.fail("Solver/Threads", "1 with Solver/Contact order = " + order +
-                                 " (bands solved at once need the fixed order)");
-    p.gap_tolerance         = f.get_checked("Solver/Gap tolerance", non_negative, "a fraction >= 0 of the smallest radius");
+    p.law    = dem::ContactLaw::parse(f, "Contact law");
+    p.solver = dem::SolverParameters::parse(f, "Solver");
 
     p.statistics_interval = f.get_integer("Output/Statistics interval");
     p.field_interval      = f.get_integer("Output/Field interval");
@@ -383,7 +261,6 @@ declare_scene_subsections(prm);
         sc.profile_samples = f.get_integer(S + "Profile samples");
         sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");
         sc.seed = f.get_integer(S + "Seed");
-        sc.upper_body_model = f.get(S + "Upper body model");
         if (const std::string sample = f.get(S + "Sample file"); !sample.empty())
           {
             const std::filesystem::path given(sample);
@@ -395,53 +272,9 @@ declare_scene_subsections(prm);
           }
         if (const std::string state = f.get(S + "Initial state"); !state.empty())
           read_initial_state(f, state, p);
-        sc.sph_smoothing_ratio = f.get_checked(S + "Upper body smoothing length ratio",
-                                               [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
-        sc.upper_youngs_modulus = f.get_checked(S + "Upper body Young's modulus", positive, "a positive modulus in Pa");
-        sc.upper_poisson_ratio = f.get_checked(S + "Upper body Poisson ratio", [](double v) { return v > -1 && v < 0.5; },
-                                               "a Poisson ratio in (-1, 0.5)");
-        sc.upper_cell_size = f.get_checked(S + "Upper body cell size", non_negative, "a size >= 0 in m");
-        sc.upper_degree = f.get_integer(S + "Upper body element degree");
-        sc.upper_modes  = f.get_integer(S + "Upper body modes");
-        sc.upper_mass_damping = f.get_checked(S + "Upper body mass damping", non_negative, "a coefficient >= 0 in 1/s");
-        sc.upper_stiffness_damping = f.get_checked(S + "Upper body stiffness damping", non_negative, "a coefficient >= 0 in s");
-        sc.half_disc_diameter = f.get_checked(S + "Half-disc diameter", non_negative, "a diameter >= 0 in m");
-        sc.upper_compaction_damping = f.get_checked(S + "Upper body compaction damping", non_negative, "a damping ratio >= 0");
-        if (sc.upper_body_model != "rigid")
-          try
-            {
-              coupling::check_first_body(first_body_parameters(p));
-            }
-          catch (const InputError &e)
-            {
-              throw InputError(f.filename() + ": " + e.what());
-            }
+        sc.upper_body = upper_body_parameters(f, p);
       }
     return p;
-  }
-
-  coupling::FirstBodyParameters first_body_parameters(const CaseParameters &p)
-  {
-    const auto                   &k = p.shear;
-    coupling::FirstBodyParameters b;
-    b.model              = k.upper_body_model;
-    b.length             = k.length;
-    b.thickness          = k.upper_body_thickness;
-    b.youngs_modulus     = k.upper_youngs_modulus;
-    b.poisson_ratio      = k.upper_poisson_ratio;
-    b.density            = k.density;
-    b.resolution         = k.upper_cell_size > 0 ? k.upper_cell_size : k.mean_diameter * (1 - k.diameter_spread);
-    b.degree             = k.upper_degree;
-    b.modes              = k.upper_modes;
-    b.rayleigh_mass      = k.upper_mass_damping;
-    b.rayleigh_stiffness = k.upper_stiffness_damping;
-    b.theta              = p.theta;
-    b.time_step          = p.time_step;
-    b.pressure           = k.pressure;
-    b.pressure_ramp_time = k.ramp_time;
-    b.compaction_damping = k.shear_start > 0 ? k.upper_compaction_damping : 0.0;
-    b.smoothing_ratio    = k.sph_smoothing_ratio;
-    return b;
   }
 
   RunRecord read_run_record(const std::string &dir)

@@ -54,22 +54,13 @@ namespace tribo::app
     std::string             initial_state;
     /// The upper first body: rigid (a rough wall, a clump of discs), or deformable and
     /// touched through half-disc elements (dem/boundary.h): fem (the deal.II body of
-    /// fem/), sph or mlp (particle blocks, coupling/particle_first_body.h).
-    std::string  upper_body_model = "rigid";
-    double       upper_youngs_modulus;  ///< E, Pa (fem, sph, mlp)
-    double       upper_poisson_ratio;   ///< nu (fem, sph, mlp)
-    /// Cell size (fem) or particle spacing (sph, mlp), m; 0: the smallest grain
-    /// diameter d(1-s)
-    double       upper_cell_size;
-    double       sph_smoothing_ratio;   ///< h / spacing (sph)
-    unsigned int upper_degree;          ///< Q_p element degree (fem, reduced)
-    unsigned int upper_modes;           ///< fixed-interface modes kept (reduced)
-    double       upper_mass_damping;    ///< Rayleigh a, 1/s (fem)
-    double       upper_stiffness_damping; ///< Rayleigh b, s (fem)
-    double       half_disc_diameter;    ///< m (fem); 0: the cell size
-    /// Damping ratio zeta of the first thickness mode added before Shear start (fem),
-    /// as stiffness-proportional damping b_c = 2 zeta / omega_1.
-    double       upper_compaction_damping;
+    /// fem/), sph or mlp (particle blocks, coupling/particle_first_body.h). Its entries
+    /// are read by coupling (FirstBodyParameters::parse()); the shear cell's fill the rest
+    /// (Length, Upper body thickness, Density, Pressure, ramp, the Simulation's theta and
+    /// time step; a cell size of 0 becomes d(1-s), and no compaction damping without a
+    /// compaction phase), checked as a whole by coupling::check_first_body(). The bottom
+    /// face y0 is the scene's to place.
+    coupling::FirstBodyParameters upper_body;
   };
 
   struct CaseParameters
@@ -82,9 +73,7 @@ namespace tribo::app
     double      start_time = 0;
     double      theta;
     dem::ContactLaw     law;
-    double              detection_distance; ///< m; 0: a tenth of the smallest radius
     dem::SolverParameters solver;
-    double              gap_tolerance; ///< Solver/Gap tolerance, fraction of the smallest radius
     unsigned int statistics_interval; ///< steps between rows of statistics.csv
     unsigned int field_interval;      ///< steps between VTU snapshots (0: first and last)
     bool         plots;               ///< PNG plots of a shear run (scripts/plot_run.py)
@@ -110,7 +99,4 @@ namespace tribo::app
 
   /// Read and check a parsed case; InputError names the entry and what was expected.
   CaseParameters read_case_parameters(const ParameterFile &file);
-  /// The shear cell's deformable upper body as the coupling module takes it (bottom
-  /// face y0 = 0: the scene places it).
-  coupling::FirstBodyParameters first_body_parameters(const CaseParameters &p);
 } // namespace tribo::app

@@ -107,9 +107,9 @@ namespace tribo::app
         scene = make_scene(p);
         scene->build(system);
         h                     = scene->time_step(system);
-        const double distance = p.detection_distance > 0 ? p.detection_distance : 0.1 * system.min_radius();
+        const double distance = p.law.detection_distance > 0 ? p.law.detection_distance : 0.1 * system.min_radius();
         dem::SolverParameters solver = p.solver;
-        solver.gap_tolerance         = p.gap_tolerance * system.min_radius();
+        solver.gap_tolerance         = p.solver.relative_gap_tolerance * system.min_radius();
         mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
         scene->attach(*mj);
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));

@@ -368,8 +368,8 @@ namespace tribo::app
       void build_deformable_upper_body(double bottom)
       {
         const auto                   &k = prm.shear;
-        coupling::FirstBodyParameters b = first_body_parameters(prm);
-        half_disc_diameter   = k.half_disc_diameter > 0 ? k.half_disc_diameter : k.length / coupling::chain_nodes(b);
+        coupling::FirstBodyParameters b = k.upper_body;
+        half_disc_diameter   = k.upper_body.half_disc_diameter > 0 ? k.upper_body.half_disc_diameter : k.length / coupling::chain_nodes(b);
         b.bottom             = bottom + 0.5 * half_disc_diameter;
         upper_y_to_surface   = 0.5 * half_disc_diameter;
         body                 = coupling::make_first_body(b);
@@ -432,7 +432,7 @@ namespace tribo::app
                        0.5 * draw_diameter(), k.density);
           }
         const double upper_y = d_max + 0.5 * pitch + (rows - 1) * dy + pitch;
-        if (k.upper_body_model != "rigid")
+        if (k.upper_body.model != "rigid")
           build_deformable_upper_body(upper_y - 0.5 * lower_wall_diameter);
         else
           add_upper_wall(s, add_wall(s, upper_y));
@@ -495,7 +495,7 @@ namespace tribo::app
               s.bodies[b].velocity     = d.velocity;
               s.bodies[b].spin         = d.spin;
             }
-        if (k.upper_body_model != "rigid")
+        if (k.upper_body.model != "rigid")
           {
             // The deformable body's surface where the upper wall's was, or just clear of
             // the grains.

@@ -65,7 +65,7 @@ int main(int argc, char **argv)
   dem::ParticleSystem system;
   scene->build(system);
   const double    h = scene->time_step(system);
-  dem::MoreauJean mj(p.theta, p.law, p.solver, p.detection_distance > 0 ? p.detection_distance : 0.1 * system.min_radius());
+  dem::MoreauJean mj(p.theta, p.law, p.solver, p.law.detection_distance > 0 ? p.law.detection_distance : 0.1 * system.min_radius());
 
   std::printf("case %s: %zu discs, h = %g s\n", case_file.c_str(), system.discs.size(), h);
   auto t0 = Clock::now();

@@ -1,6 +1,9 @@
 #include "coupling/first_body.h"
 
 #include "core/errors.h"
+#include "core/parameter_file.h"
+
+#include <deal.II/base/parameter_handler.h>
 
 #include <cmath>
 #include <sstream>
@@ -26,7 +29,7 @@ namespace tribo::coupling
     std::unique_ptr<FirstBody> make_fem_first_body(const FirstBodyParameters &p);
 #endif
 
-    /// The upper first-body models (Shear cell/Upper body model): name, least number of
+    /// The upper first-body models (the Upper body model entry): name, least number of
     /// chain nodes, the build option of their module and their factory (null when the
     /// build left the module out).
     struct FirstBodyModel
@@ -66,6 +69,77 @@ namespace tribo::coupling
     }
   } // namespace
 
+  void FirstBodyParameters::declare(dealii::ParameterHandler &prm)
+  {
+    using dealii::Patterns::Double;
+    using dealii::Patterns::Integer;
+    using dealii::Patterns::Selection;
+    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
+                      "rigid: a rough wall of discs with the mass of the first body (the paper's "
+                      "classical model); fem: a plane-strain elastic body of that thickness "
+                      "(deal.II), touched through half-disc elements (the paper's hybrid model); reduced: "
+                      "that body condensed onto its contact nodes plus Upper body modes vibration modes "
+                      "(Craig-Bampton), cheaper than fem, exact in the static limit; "
+                      "sph, mlp: the same body as an SPH (square lattice) or movable-lattice-particle "
+                      "(hexagonal lattice) block whose bottom row of particles carries the half-discs, "
+                      "sub-cycled inside each contact step (docs/first_bodies.md).");
+    prm.declare_entry("Upper body Young's modulus", "1e11", Double(),
+                      "E of the deformable upper body, Pa (> 0; paper: 1e11 and 3e9).");
+    prm.declare_entry("Upper body Poisson ratio", "0.33", Double(),
+                      "nu of the deformable upper body, plane strain (in (-1, 0.5); paper: 0.33; "
+                      "mlp: at most 0.25).");
+    prm.declare_entry("Upper body cell size", "0", Double(),
+                      "Cell size of the fem upper body's mesh, or particle spacing of the sph and mlp "
+                      "bodies, m (>= 0); 0: the smallest grain diameter d(1-s), the paper's choice.");
+    prm.declare_entry("Upper body smoothing length ratio", "1.2", Double(),
+                      "Smoothing length over particle spacing of the sph upper body (in [1, 2]).");
+    prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
+                      "Degree p of the fem upper body's Q_p elements.");
+    prm.declare_entry("Upper body modes", "20", Integer(0),
+                      "Fixed-interface vibration modes kept by the reduced upper body (>= 0; 0: static "
+                      "condensation plus the load mode only), docs/fem.md.");
+    prm.declare_entry("Upper body mass damping", "0", Double(),
+                      "Rayleigh coefficient a of C = a M + b K for the fem upper body, 1/s (>= 0).");
+    prm.declare_entry("Upper body stiffness damping", "0", Double(),
+                      "Rayleigh coefficient b of C = a M + b K for the fem upper body, s (>= 0).");
+    prm.declare_entry("Half-disc diameter", "0", Double(),
+                      "Diameter of the half-disc contact elements on the fem upper body, m (>= 0); "
+                      "0: the cell size (one per boundary edge, the paper's choice).");
+    prm.declare_entry("Upper body compaction damping", "1", Double(),
+                      "Damping ratio zeta (>= 0) of the deformable upper body's first thickness mode, "
+                      "omega_1 = pi c_p / (2 H), added before Shear start as damping of the velocity "
+                      "towards rest at gamma = 2 zeta omega_1 (fem: mass-proportional Rayleigh damping) "
+                      "and removed when shearing starts: the body then lands on the layer at the "
+                      "terminal speed P / (rho H gamma) (0.7 m/s for the paper's steel body) instead of "
+                      "falling freely onto it, and does not ring (no numerical damping at theta = 0.5). "
+                      "The rigid wall's Compaction speed limit plays this part. 0: off.");
+  }
+
+  FirstBodyParameters FirstBodyParameters::parse(const ParameterFile &f, const std::string &section)
+  {
+    const auto positive     = [](double v) { return v > 0 && std::isfinite(v); };
+    const auto non_negative = [](double v) { return v >= 0 && std::isfinite(v); };
+    FirstBodyParameters p;
+    p.section        = {section};
+    const auto entry = [&](const std::string &name) { return p.section.entry(name); };
+    p.model          = f.get(entry("Upper body model"));
+    p.smoothing_ratio = f.get_checked(entry("Upper body smoothing length ratio"),
+                                      [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
+    p.youngs_modulus = f.get_checked(entry("Upper body Young's modulus"), positive, "a positive modulus in Pa");
+    p.poisson_ratio  = f.get_checked(entry("Upper body Poisson ratio"), [](double v) { return v > -1 && v < 0.5; },
+                                     "a Poisson ratio in (-1, 0.5)");
+    p.resolution     = f.get_checked(entry("Upper body cell size"), non_negative, "a size >= 0 in m");
+    p.degree         = f.get_integer(entry("Upper body element degree"));
+    p.modes          = f.get_integer(entry("Upper body modes"));
+    p.rayleigh_mass  = f.get_checked(entry("Upper body mass damping"), non_negative, "a coefficient >= 0 in 1/s");
+    p.rayleigh_stiffness =
+      f.get_checked(entry("Upper body stiffness damping"), non_negative, "a coefficient >= 0 in s");
+    p.half_disc_diameter = f.get_checked(entry("Half-disc diameter"), non_negative, "a diameter >= 0 in m");
+    p.compaction_damping =
+      f.get_checked(entry("Upper body compaction damping"), non_negative, "a damping ratio >= 0");
+    return p;
+  }
+
   unsigned int chain_nodes(const FirstBodyParameters &p)
   {
     return std::max(model_of(p).min_chain_nodes, std::lround(p.length / p.resolution));
@@ -96,26 +170,26 @@ namespace tribo::coupling
         const long nxp = long(nx) * p.degree, nyp = long(ny) * p.degree;
         const long interior = 2 * nxp * (nyp + 1) - 2 * long(nx) - nxp;
         if (long(p.modes) + 2 > interior)
-          throw InputError("entry 'Shear cell/Upper body modes' = '" + std::to_string(p.modes) +
+          throw InputError("entry '" + p.section.entry("Upper body modes") + "' = '" + std::to_string(p.modes) +
                            "': expected at most " + std::to_string(interior - 2) + ", the body's " +
                            std::to_string(interior) + " interior unknowns less 2");
       }
     if (p.model != "sph" && p.model != "mlp")
       return;
     if (p.model == "mlp" && p.poisson_ratio > 0.25 + 1e-12)
-      throw InputError("entry 'Shear cell/Upper body Poisson ratio' = '" + to_text(p.poisson_ratio) +
+      throw InputError("entry '" + p.section.entry("Upper body Poisson ratio") + "' = '" + to_text(p.poisson_ratio) +
                        "': an mlp upper body needs nu <= 0.25 (its plane-strain 2D ratio nu/(1 - nu) must "
                        "be <= 1/3: return forces can only lower it); use 0.25 or less, or Upper body "
                        "model = fem or sph");
     const double s = p.length / chain_nodes(p), c = p_wave_speed(p);
     const double h_max = particle_coupling_courant * s / c;
     if (p.time_step > h_max * (1 + 1e-12))
-      throw InputError("entry 'Simulation/Time step' = '" + to_text(p.time_step) + "': an " + p.model +
+      throw InputError("entry '" + p.time_step_entry + "' = '" + to_text(p.time_step) + "': an " + p.model +
                        " upper body is kicked by the contacts once per step, stable only for c_p h / s <= " +
                        to_text(particle_coupling_courant) + "; with c_p = " + to_text(c) +
                        " m/s and particle spacing s = " + to_text(s) + " m that is h <= " + to_text(h_max) +
-                       " s: use Simulation/Time step = " + to_text(h_max) +
-                       " or less, or a larger Shear cell/Upper body cell size");
+                       " s: use " + p.time_step_entry + " = " + to_text(h_max) + " or less, or a larger " +
+                       p.section.entry("Upper body cell size"));
   }
 
   std::string first_body_snapshot_name(unsigned int index)
@@ -153,7 +227,7 @@ namespace tribo::coupling
       e.density        = p.density;
       std::tie(e.cells_x, e.cells_y) = fem_cells(p);
       if (double(e.cells_x) * e.cells_y > 4e6)
-        throw InputError("entry 'Shear cell/Upper body cell size' = '" + to_text(p.resolution) +
+        throw InputError("entry '" + p.section.entry("Upper body cell size") + "' = '" + to_text(p.resolution) +
                          "': expected a cell size giving at most 4e6 cells; it gives " +
                          to_text(double(e.cells_x) * e.cells_y) + " cells");
       e.degree             = p.degree;
@@ -181,7 +255,7 @@ namespace tribo::coupling
     check_first_body(p);
     const FirstBodyModel &m = model_of(p);
     if (!m.make)
-      throw InputError("Shear cell/Upper body model = " + p.model + " needs a module this build left out (" +
+      throw InputError(p.section.entry("Upper body model") + " = " + p.model + " needs a module this build left out (" +
                        m.build_option + "=OFF); rebuild with -D" + m.build_option + "=ON");
     return m.make(p);
   }

@@ -3,7 +3,7 @@
 /// of object: the solver's coupling interface (dem::BoundaryBody, ../shared/DESIGN.md
 /// section 3) plus what the scene measures, writes and checkpoints.
 ///
-/// Models (Shear cell/Upper body model):
+/// Models (the Upper body model entry, FirstBodyParameters::declare()):
 /// - fem: the deal.II plane-strain body (fem/), implicit Moreau-Jean, its bottom face
 ///   condensed onto its contact nodes (coupling/elastic_boundary.h);
 /// - reduced: the same body, Craig-Bampton reduced to its contact nodes plus a few
@@ -20,6 +20,7 @@
 /// Units per unit depth: m, kg/m, N/m, J/m, W/m.
 
 #include "core/checkpoint.h"
+#include "core/parameter_section.h"
 #include "dem/boundary.h"
 
 #include <memory>
@@ -27,27 +28,36 @@
 
 namespace tribo::coupling
 {
-  /// Geometry, material and loading of an upper first body (SI units).
+  /// Geometry, material and loading of an upper first body (SI units). The body's own
+  /// entries (model, material, resolution, damping, half-discs) are declared and read
+  /// here (declare(), parse()); the scene gives the rest (period, thickness, density,
+  /// load, time step).
   struct FirstBodyParameters
   {
-    std::string  model = "fem"; ///< fem | reduced | sph | mlp
-    double       length = 0;    ///< L: period along x, m
-    double       thickness = 0; ///< H, m
-    double       bottom = 0;    ///< y0 of the bottom face (the contact chain), m
+    /// rigid | fem | reduced | sph | mlp. rigid is no FirstBody: the scene's rough wall of
+    /// discs (the entry's default); the others are made by make_first_body().
+    std::string  model = "rigid";
+    double       length = 0;    ///< L: period along x, m (scene)
+    double       thickness = 0; ///< H, m (scene)
+    double       bottom = 0;    ///< y0 of the bottom face (the contact chain), m (scene)
     double       youngs_modulus = 0; ///< E, Pa
     double       poisson_ratio = 0;  ///< nu (plane strain)
-    double       density = 0;        ///< rho, kg/m^3
+    double       density = 0;        ///< rho, kg/m^3 (scene)
     /// Cell size (fem) or particle spacing (sph, mlp), m: the chain has
-    /// chain_nodes() = max(minimum, round(L / resolution)) nodes.
+    /// chain_nodes() = max(minimum, round(L / resolution)) nodes. 0 from the case: the
+    /// scene sets it.
     double       resolution = 0;
     unsigned int degree = 1;            ///< Q_p degree (fem, reduced)
     unsigned int modes = 20;            ///< fixed-interface modes kept (reduced)
     double       rayleigh_mass = 0;      ///< a of C = a M + b K while shearing, 1/s (fem)
     double       rayleigh_stiffness = 0; ///< b, s (fem)
-    double       theta = 0.5;            ///< Moreau-Jean theta (fem)
-    double       time_step = 0;          ///< contact step h, s
-    double       pressure = 0;           ///< P, Pa (> 0: compressive)
-    double       pressure_ramp_time = 0; ///< s; 0: a step at t = 0
+    /// Diameter of the half-disc contact elements on the chain, m; 0: the chain's node
+    /// spacing L / chain_nodes() (the scene attaches them).
+    double       half_disc_diameter = 0;
+    double       theta = 0.5;            ///< Moreau-Jean theta (fem; scene)
+    double       time_step = 0;          ///< contact step h, s (scene)
+    double       pressure = 0;           ///< P, Pa (> 0: compressive; scene)
+    double       pressure_ramp_time = 0; ///< s; 0: a step at t = 0 (scene)
     /// Damping ratio zeta of the first thickness mode, omega_1 = pi c_p / (2 H), until
     /// start_shearing() (0: none), in every model as damping of the velocity towards rest
     /// at gamma = 2 zeta omega_1 (1/s; fem: mass-proportional Rayleigh a_c = gamma),
@@ -58,6 +68,20 @@ namespace tribo::coupling
     double       compaction_damping = 0;
     /// Smoothing length over spacing (sph).
     double       smoothing_ratio = 1.2;
+    /// The case subsection the body's entries were read from: messages name them
+    /// through it.
+    ParameterSection section;
+    /// The case entry that sets time_step, named when the step is too long for the
+    /// coupling (check_first_body()).
+    std::string time_step_entry = "time step";
+
+    /// Declare the body's entries in the current subsection of @p prm (the caller enters
+    /// and leaves it).
+    static void declare(dealii::ParameterHandler &prm);
+    /// The body's entries of subsection @p section of @p file, each checked on its own
+    /// (InputError naming the file, the line and the entry); the scene's fields keep
+    /// their defaults, and check_first_body() checks the whole once they are set.
+    static FirstBodyParameters parse(const ParameterFile &file, const std::string &section);
   };
 
   /// Number of chain nodes the model places along L for @p p (fem: cells along x;

@@ -105,7 +105,7 @@ namespace tribo::coupling
        << "its chain, whose particles are kicked once per contact step and give way in between: "
        << "here c_p h / s = " << c * h / s << " (c_p = " << c << " m/s, s = " << s << " m)";
     if (c * h / s > 0.5 * particle_coupling_courant)
-      os << "; a smaller Simulation/Time step holds them better (h = " << 0.5 * h_safe
+      os << "; a smaller " << prm.time_step_entry << " holds them better (h = " << 0.5 * h_safe
          << " s is half the coupling limit; docs/first_bodies.md)";
     return os.str();
   }

@@ -73,7 +73,7 @@ namespace tribo::dem
         ++report.factorizations;
         if (cholesky.info() != Eigen::Success)
           throw RunError("the active-set method could not factorise the Delassus operator of "
-                         "the loaded contacts (Solver/Regularization too small?)");
+                         "the loaded contacts (" + prm.section.entry("Regularization") + " too small?)");
         for (Eigen::Index i = 0; i < n; ++i)
           rhs[i] = -w[i];
         d = cholesky.solve(rhs); // free: -(A_FF + delta D)^-1 w_F; binding: -w_B / D_B

@@ -26,11 +26,13 @@
 /// - Optional Coulomb friction mu: |r_t| <= mu r~_n, acting on the shifted impulse.
 
 #include "core/errors.h"
+#include "core/parameter_section.h"
 
 #include <Eigen/Core>
 
 #include <cmath>
 #include <sstream>
+#include <string>
 
 namespace tribo::dem
 {
@@ -51,6 +53,19 @@ namespace tribo::dem
     /// (shift beta g/(theta h) for g < 0). 0 freezes overlaps (the paper's IQS);
     /// beta > 0 stops NLGS errors from accumulating into overlaps.
     double overlap_recovery = 0;
+    /// Pairs closer than this gap enter the contact list, m; 0: the run's choice (a tenth
+    /// of the smallest radius). Read with the law (its entry is in the law's subsection);
+    /// the law itself does not use it: MoreauJean takes the distance the run settles on.
+    double detection_distance = 0;
+    /// The case subsection the law was read from: its messages name entries through it.
+    ParameterSection section;
+
+    /// Declare the law's entries, and Detection distance, in the current subsection of
+    /// @p prm (the caller enters and leaves it).
+    static void declare(dealii::ParameterHandler &prm);
+    /// The law of subsection @p section of @p file, checked; InputError names the file,
+    /// the line and the entry.
+    static ContactLaw parse(const ParameterFile &file, const std::string &section);
 
     /// The terms of one contact's local problem that depend on its gap.
     struct Terms

@@ -404,12 +404,16 @@ namespace tribo::dem
              << ", moved " << speed * h << " m in the step (" << speed << " m/s); a step of at most "
              << 0.25 * r_min / speed << " s keeps it within a quarter of the smallest radius";
         else
-          os << "No body moved more than a quarter of the smallest radius in the step: the "
-                "overlap does not come from the step size. Either discs were placed overlapping, "
-                "or the law lets it grow: with IQS, overlaps kept step after step within the "
-                "solver's tolerance (high pressure: tighten Solver/Tolerance or Solver/Gap "
-                "tolerance, or set Contact law/Overlap recovery); with ELAS, a stiffness too low "
-                "for the load (docs/laws.md)";
+          {
+            const ParameterSection &solver_section = solver.parameters().section;
+            os << "No body moved more than a quarter of the smallest radius in the step: the "
+                  "overlap does not come from the step size. Either discs were placed overlapping, "
+                  "or the law lets it grow: with IQS, overlaps kept step after step within the "
+                  "solver's tolerance (high pressure: tighten "
+               << solver_section.entry("Tolerance") << " or " << solver_section.entry("Gap tolerance")
+               << ", or set " << contact_law.section.entry("Overlap recovery")
+               << "); with ELAS, a stiffness too low for the load (docs/laws.md)";
+          }
         if (const std::string hint = boundary ? boundary->overlap_hint(h) : std::string(); !hint.empty())
           os << ". " << hint;
         throw RunError(os.str());

@@ -113,9 +113,21 @@ namespace tribo::dem
     /// with normal velocities whose small errors freeze into overlaps step after
     /// step (docs/laws.md).
     double gap_tolerance = 0;
+    /// Solver/Gap tolerance as the case gives it: a fraction of the smallest radius (the run
+    /// sets gap_tolerance = this times the smallest radius once the discs are known).
+    double relative_gap_tolerance = 0;
+    /// The case subsection these controls were read from: messages name entries through it.
+    ParameterSection section;
+
+    /// Declare the solver's entries in the current subsection of @p prm (the caller
+    /// enters and leaves it).
+    static void declare(dealii::ParameterHandler &prm);
+    /// The controls of subsection @p section of @p file, checked; InputError names the
+    /// file, the line and the entry.
+    static SolverParameters parse(const ParameterFile &file, const std::string &section);
   };
 
-  /// The name of @p method as Solver/Method spells it.
+  /// The name of @p method as the Method entry (SolverParameters::declare()) spells it.
   inline std::string method_name(SolverParameters::Method method)
   {
     switch (method)

@@ -257,7 +257,64 @@ namespace tribo::fem
     void assemble(const AffineConstraints<double> &c, SparseMatrix<double> *mass, SparseMatrix<double> &stiffness,
                   Vector<double> &load) const;
     void find_boundary_nodes();
+
+    /// Craig-Bampton reduction (ElasticBodyParameters::reduced): u = T q with
+    /// q = (u_b, eta, zeta), T = [I 0 0; Psi Phi X]; M, K, f become T^T M T, T^T K T,
+    /// T^T f. Each step below is one member function.
     void reduce();
+    /// The interior problem of the reduction: the mesh's stiffness K_ii and mass M_ii
+    /// with the boundary unknowns u_b held at 0 (the mesh's own constraints kept), K_ii
+    /// factorised. Not movable: the matrices refer to the sparsity pattern.
+    struct Interior
+    {
+      AffineConstraints<double>     held; ///< u_b = 0 merged with the mesh's constraints
+      SparsityPattern               sparsity;
+      SparseMatrix<double>          K, M; ///< K_ii (N/m^2), M_ii (kg/m) per unit depth, condensed like K, M
+      std::unique_ptr<DirectSolver> solver; ///< factorisation of K_ii
+
+      /// Number of interior unknowns: the mesh's dofs less the held and constrained ones.
+      std::size_t n_unknowns() const { return K.m() - held.n_constraints(); }
+      /// x := K_ii^-1 x on the interior unknowns, 0 on the held ones.
+      void solve(Vector<double> &x)
+      {
+        held.set_zero(x);
+        solver->solve(x.data(), 1);
+        held.set_zero(x);
+      }
+      /// w := M_ii x, 0 on the held rows.
+      void vmult_mass(Vector<double> &w, const Vector<double> &x) const
+      {
+        M.vmult(w, x);
+        held.set_zero(w);
+      }
+    };
+    /// boundary_dofs: the dof of each bottom node component (u_b, index 2i + component);
+    /// throws RunError if one is not a single unconstrained dof.
+    void collect_boundary_dofs();
+    /// Assemble K_ii and M_ii with u_b held (the same assembly as the mesh's) and
+    /// factorise K_ii.
+    void assemble_interior(Interior &interior) const;
+    /// Column @p column of T from the mesh vector @p x, the mesh's constraints
+    /// distributed into x first.
+    void store_basis_column(Vector<double> &x, unsigned int column);
+    /// Columns 0 .. 2n-1 of T: the constraint modes, the static shape of a unit
+    /// displacement of boundary unknown j, u_i = Psi e_j = -K_ii^-1 K_ib e_j, u_b = e_j.
+    void add_constraint_modes(Interior &interior);
+    /// Columns 2n .. 2n+k-1 of T and omega: the k = modes lowest fixed-interface modes,
+    /// K_ii phi = omega^2 M_ii phi (u_b = 0), by ARPACK in shift-invert mode about 0,
+    /// M-orthonormal (phi^T M_ii phi = 1), omega in rad/s.
+    void add_fixed_interface_modes(Interior &interior);
+    /// Column 2n+k of T: the load mode, the interior's static response to the unit top
+    /// pressure, x = K_ii^-1 f_i, made M-orthogonal to Phi,
+    /// x := x - sum_m (x^T M_ii phi_m) phi_m, and M-normalised, x^T M_ii x = 1.
+    void add_load_mode(Interior &interior);
+    /// The reduced matrix T^T A T (r x r) of the mesh's condensed @p A, symmetrised,
+    /// (P + P^T) / 2, against round-off.
+    Eigen::MatrixXd project(const SparseMatrix<double> &A) const;
+    /// Make q the model's unknowns: M := T^T M T, K := T^T K T, f_unit := T^T f_unit as
+    /// dense r x r (r-vector) in deal.II's sparse format, node i's components the
+    /// unknowns 2i, 2i + 1 of q, and no constraints left.
+    void use_reduced_coordinates();
     /// The mesh's dof vector of a model vector: T x (reduced) or x itself.
     Vector<double> full(const Vector<double> &x) const
     {
@@ -461,7 +518,23 @@ namespace tribo::fem
   // Craig-Bampton: T = [I 0 0; Psi Phi X] on q = (u_b, eta, zeta) (elastic_body.h).
   void ElasticBody::Impl::reduce()
   {
-    const std::size_t  N  = dof.n_dofs();
+    collect_boundary_dofs();
+    Interior interior;
+    assemble_interior(interior);
+    const std::size_t n_interior = interior.n_unknowns();
+    if (prm.modes + 2 > n_interior)
+      throw InputError("ElasticBody: " + std::to_string(prm.modes) + " modes asked of a body with " +
+                       std::to_string(n_interior) + " interior unknowns: at most " +
+                       std::to_string(n_interior - 2));
+    basis.setZero(dof.n_dofs(), boundary_dofs.size() + prm.modes + 1);
+    add_constraint_modes(interior);
+    add_fixed_interface_modes(interior);
+    add_load_mode(interior);
+    use_reduced_coordinates();
+  }
+
+  void ElasticBody::Impl::collect_boundary_dofs()
+  {
     const unsigned int nb = node_z.size();
     boundary_dofs.resize(nb);
     for (unsigned int j = 0; j < nb; ++j)
@@ -471,9 +544,12 @@ namespace tribo::fem
                          "component " + std::to_string(j % 2) + " of node " + std::to_string(j / 2) + " is not");
         boundary_dofs[j] = node_z[j][0].first;
       }
+  }
 
-    // K_ii, M_ii: the same assembly with the boundary held (u_b = 0).
-    AffineConstraints<double> held;
+  void ElasticBody::Impl::assemble_interior(Interior &interior) const
+  {
+    const std::size_t          N    = dof.n_dofs();
+    AffineConstraints<double> &held = interior.held;
     for (const auto d : boundary_dofs)
       held.add_line(d);
     held.close();
@@ -481,120 +557,120 @@ namespace tribo::fem
     held.close();
     DynamicSparsityPattern dsp(N);
     DoFTools::make_sparsity_pattern(dof, dsp, held, false);
-    SparsityPattern held_sparsity;
-    held_sparsity.copy_from(dsp);
-    SparseMatrix<double> K_held(held_sparsity), M_held(held_sparsity);
-    Vector<double>       f_held(N);
-    assemble(held, &M_held, K_held, f_held);
-    const auto interior = make_direct_solver(prm.solver);
-    interior->factorize(K_held);
-    // x := K_ii^-1 x on the interior unknowns, 0 on the held ones.
-    const auto solve_interior = [&](Vector<double> &x) {
-      held.set_zero(x);
-      interior->solve(x.data(), 1);
-      held.set_zero(x);
-    };
+    interior.sparsity.copy_from(dsp);
+    interior.K.reinit(interior.sparsity);
+    interior.M.reinit(interior.sparsity);
+    Vector<double> f_held(N);
+    assemble(held, &interior.M, interior.K, f_held);
+    interior.solver = make_direct_solver(prm.solver);
+    interior.solver->factorize(interior.K);
+  }
 
-    const std::size_t n_interior = N - held.n_constraints();
-    if (prm.modes + 2 > n_interior)
-      throw InputError("ElasticBody: " + std::to_string(prm.modes) + " modes asked of a body with " +
-                       std::to_string(n_interior) + " interior unknowns: at most " +
-                       std::to_string(n_interior - 2));
-    const unsigned int k = prm.modes, r = nb + k + 1;
-    basis.setZero(N, r);
-    Vector<double> x(N), w(N);
-    const auto     store = [&](unsigned int column) {
-      constraints.distribute(x);
-      std::copy(x.begin(), x.end(), basis.col(column).data());
-    };
+  void ElasticBody::Impl::store_basis_column(Vector<double> &x, unsigned int column)
+  {
+    constraints.distribute(x);
+    std::copy(x.begin(), x.end(), basis.col(column).data());
+  }
 
-    // Psi: u_i = -K_ii^-1 K_ib e_j for a unit displacement of boundary unknown j.
-    for (unsigned int j = 0; j < nb; ++j)
+  void ElasticBody::Impl::add_constraint_modes(Interior &interior)
+  {
+    const std::size_t N = dof.n_dofs();
+    Vector<double>    x(N), w(N);
+    for (unsigned int j = 0; j < boundary_dofs.size(); ++j)
       {
         w                   = 0;
         w[boundary_dofs[j]] = 1;
         K.vmult(x, w);
         x *= -1;
-        solve_interior(x);
+        interior.solve(x);
         x[boundary_dofs[j]] = 1;
-        store(j);
+        store_basis_column(x, j);
       }
+  }
 
-    // Phi: the k lowest modes of K_ii phi = omega^2 M_ii phi, shift-invert about 0.
-    std::vector<Vector<double>> phi;
-    if (k > 0)
+  void ElasticBody::Impl::add_fixed_interface_modes(Interior &interior)
+  {
+    const unsigned int k = prm.modes, nb = boundary_dofs.size();
+    if (k == 0)
+      return;
+    const std::size_t    N = dof.n_dofs();
+    Vector<double>       x(N), w(N);
+    const ActionOperator inverse{[&](Vector<double> &dst, const Vector<double> &src) {
+      dst = src;
+      interior.solve(dst);
+    }};
+    const ActionOperator mass{[&](Vector<double> &dst, const Vector<double> &src) { interior.vmult_mass(dst, src); }};
+    // Lanczos vectors: 2k + 2 (at least 20), at most the interior's dimension.
+    const unsigned int arnoldi = std::min<std::size_t>(interior.n_unknowns(), std::max(2 * k + 2, 20U));
+    SolverControl      control(10 * N, 1e-10);
+    ArpackSolver       arpack(control, ArpackSolver::AdditionalData(arnoldi, ArpackSolver::largest_magnitude, true));
+    std::vector<std::complex<double>> lambda(k);
+    std::vector<Vector<double>>       phi(k, Vector<double>(N));
+    arpack.solve(interior.K, mass, inverse, lambda, phi, k);
+    std::vector<unsigned int> order(k);
+    for (unsigned int i = 0; i < k; ++i)
+      order[i] = i;
+    std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) { return lambda[a].real() < lambda[b].real(); });
+    omega.clear();
+    for (unsigned int i = 0; i < k; ++i)
       {
-        const ActionOperator inverse{[&](Vector<double> &dst, const Vector<double> &src) {
-          dst = src;
-          solve_interior(dst);
-        }};
-        const ActionOperator mass{[&](Vector<double> &dst, const Vector<double> &src) {
-          M_held.vmult(dst, src);
-          held.set_zero(dst);
-        }};
-        // Lanczos vectors: 2k + 2 (at least 20), at most the interior's dimension.
-        const unsigned int arnoldi = std::min<std::size_t>(n_interior, std::max(2 * k + 2, 20U));
-        SolverControl      control(10 * N, 1e-10);
-        ArpackSolver       arpack(control, ArpackSolver::AdditionalData(arnoldi, ArpackSolver::largest_magnitude, true));
-        std::vector<std::complex<double>> lambda(k);
-        phi.assign(k, Vector<double>(N));
-        arpack.solve(K_held, mass, inverse, lambda, phi, k);
-        std::vector<unsigned int> order(k);
-        for (unsigned int i = 0; i < k; ++i)
-          order[i] = i;
-        std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) { return lambda[a].real() < lambda[b].real(); });
-        omega.clear();
-        for (unsigned int i = 0; i < k; ++i)
-          {
-            x = phi[order[i]];
-            held.set_zero(x);
-            mass.vmult(w, x);
-            x /= std::sqrt(x * w); // M-orthonormal
-            omega.push_back(std::sqrt(lambda[order[i]].real()));
-            store(nb + i);
-          }
+        x = phi[order[i]];
+        interior.held.set_zero(x);
+        mass.vmult(w, x);
+        x /= std::sqrt(x * w); // M-orthonormal
+        omega.push_back(std::sqrt(lambda[order[i]].real()));
+        store_basis_column(x, nb + i);
       }
+  }
 
-    // X: the interior's static response to the unit top load, M-orthogonal to Phi.
-    x = f_unit;
-    solve_interior(x);
-    {
-      Eigen::Map<Eigen::VectorXd> xe(x.data(), N);
-      for (unsigned int i = 0; i < k; ++i)
-        {
-          Vector<double> p(N);
-          std::copy(basis.col(nb + i).data(), basis.col(nb + i).data() + N, p.begin());
-          held.set_zero(p);
-          M_held.vmult(w, p);
-          held.set_zero(w);
-          x.add(-(x * w), p);
-        }
-      M_held.vmult(w, x);
-      held.set_zero(w);
-      const double norm = std::sqrt(x * w);
-      if (norm > 0)
-        xe /= norm;
-    }
-    store(nb + k);
+  void ElasticBody::Impl::add_load_mode(Interior &interior)
+  {
+    const unsigned int k = prm.modes, nb = boundary_dofs.size();
+    const std::size_t  N = dof.n_dofs();
+    Vector<double>     x(f_unit), w(N);
+    interior.solve(x);
+    Eigen::Map<Eigen::VectorXd> xe(x.data(), N);
+    for (unsigned int i = 0; i < k; ++i)
+      {
+        Vector<double> p(N);
+        std::copy(basis.col(nb + i).data(), basis.col(nb + i).data() + N, p.begin());
+        interior.held.set_zero(p);
+        interior.vmult_mass(w, p);
+        x.add(-(x * w), p);
+      }
+    interior.vmult_mass(w, x);
+    const double norm = std::sqrt(x * w);
+    if (norm > 0)
+      xe /= norm;
+    store_basis_column(x, nb + k);
+  }
 
-    // T^T M T, T^T K T, T^T f, with the mesh's (condensed) matrices.
-    const auto project = [&](const SparseMatrix<double> &A) {
-      Eigen::MatrixXd AT(N, r);
-      for (unsigned int c = 0; c < r; ++c)
-        {
-          std::copy(basis.col(c).data(), basis.col(c).data() + N, x.begin());
-          vmult_free(A, x, w);
-          std::copy(w.begin(), w.end(), AT.col(c).data());
-        }
-      Eigen::MatrixXd P = basis.transpose() * AT;
-      return Eigen::MatrixXd(0.5 * (P + P.transpose()));
-    };
+  Eigen::MatrixXd ElasticBody::Impl::project(const SparseMatrix<double> &A) const
+  {
+    const std::size_t N = dof.n_dofs();
+    const Eigen::Index r = basis.cols();
+    Vector<double>    x(N), w(N);
+    Eigen::MatrixXd   AT(N, r);
+    for (Eigen::Index c = 0; c < r; ++c)
+      {
+        std::copy(basis.col(c).data(), basis.col(c).data() + N, x.begin());
+        vmult_free(A, x, w);
+        std::copy(w.begin(), w.end(), AT.col(c).data());
+      }
+    Eigen::MatrixXd P = basis.transpose() * AT;
+    return Eigen::MatrixXd(0.5 * (P + P.transpose()));
+  }
+
+  void ElasticBody::Impl::use_reduced_coordinates()
+  {
+    const std::size_t  N = dof.n_dofs();
+    const unsigned int r = basis.cols(), nb = boundary_dofs.size();
     const Eigen::MatrixXd M_r = project(M), K_r = project(K);
     Eigen::Map<const Eigen::VectorXd> f(f_unit.data(), N);
     const Eigen::VectorXd             f_r = basis.transpose() * f;
 
-    // The model is now q: dense r x r matrices in deal.II's sparse format (CHOLMOD
-    // factorises them as before), boundary unknowns first, no constraints.
+    // Dense r x r matrices in deal.II's sparse format (CHOLMOD factorises them as
+    // before), boundary unknowns first, no constraints.
     DynamicSparsityPattern full_pattern(r, r);
     for (unsigned int i = 0; i < r; ++i)
       for (unsigned int j = 0; j < r; ++j)

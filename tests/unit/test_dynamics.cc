@@ -270,8 +270,14 @@ namespace
 TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
 {
   // Discs placed overlapping by 0.7 um (> r = 0.6 um), at rest: IQS freezes the overlap.
-  ParticleSystem placed = pair_at(2 * r - 0.7e-6, 0);
-  MoreauJean     mj(0.5, ContactLaw{}, tight(), 1e-8);
+  // The message names the entries to change in the subsections the law and the solver
+  // were read from.
+  ParticleSystem   placed = pair_at(2 * r - 0.7e-6, 0);
+  ContactLaw       law;
+  SolverParameters solver = tight();
+  law.section             = {"Contact law"};
+  solver.section          = {"Solver"};
+  MoreauJean mj(0.5, law, solver, 1e-8);
   EXPECT_EQ(step_error(mj, placed, 1e-8),
             "an overlap of 7e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
             "missed or left unresolved (nlgs converged). No body moved more than a quarter of "
