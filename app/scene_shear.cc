@@ -18,6 +18,7 @@
 #include "app/profiles.h"
 #include "app/sample_file.h"
 #include "app/scene.h"
+#include "app/shear_upper_body.h"
 #include "app/steady_state.h"
 #include "core/errors.h"
 
@@ -28,6 +29,7 @@
 #include <boost/serialization/string.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <sstream>
 #include <cmath>
 #include <limits>
@@ -59,14 +61,14 @@ namespace tribo::app
         unsigned int grains = 0;
         mean_grain_diameter = 0;
         for (const auto &d : s.discs)
-          if (d.body != lower && d.body != upper)
+          if (d.body != lower && d.body != upper_body->system_body())
             {
               mean_grain_diameter += 2 * d.radius;
               ++grains;
             }
         mean_grain_diameter /= grains;
         profiles = std::make_unique<LayerProfiles>(
-          lower, upper, 0.5 * lower_wall_diameter,
+          lower, upper_body->system_body(), 0.5 * lower_wall_diameter,
           k.layer_thickness > 0 ? k.layer_thickness : k.sample.empty() ? k.mean_diameter : mean_grain_diameter);
       }
 
@@ -74,49 +76,29 @@ namespace tribo::app
       {
         const auto  &k    = prm.shear;
         const double t    = step * prm.time_step;
-        // A deformable body placed on a state takes its load from the state's time on, on
-        // its own clock; the rigid wall of a state goes on with the state's ramp.
-        const double t_load = body ? t - prm.start_time : t;
+        const double t_load = upper_body->load_time(t, prm.start_time);
         const double ramp   = k.ramp_time > 0 ? std::min(1.0, (t_load + prm.time_step) / k.ramp_time) : 1.0;
         normal_force                 = ramp * k.pressure * k.length;
         sliding                      = t >= k.shear_start;
         s.bodies[lower].velocity.x() = sliding ? k.sliding_velocity : 0.0;
-        if (body)
-          {
-            // The body ramps its own load, with the same law; the compaction damping
-            // goes when shearing starts.
-            if (sliding)
-              body->start_shearing();
-            return;
-          }
-        s.bodies[upper].load[1] = -normal_force;
-        // Compaction: cap the upper wall's speed (numerical damping, compaction only).
-        auto &vy = s.bodies[upper].velocity.y();
-        if (t < k.shear_start && k.compaction_speed > 0)
-          vy = std::clamp(vy, -k.compaction_speed, k.compaction_speed);
+        upper_body->before_step(s, normal_force, sliding, t < k.shear_start ? k.compaction_speed : 0.0);
       }
 
-      std::string description() const override { return body ? body->describe() : ""; }
+      std::string description() const override { return upper_body->describe(); }
 
       /// The grains and both walls; with a deformable upper body the grains and the lower
       /// wall (the body is not made of discs: a run from the sample puts its own upper
       /// body or a generated wall above the grains).
       std::string sample(const dem::ParticleSystem &s) const override
       {
-        return sample_text(s, lower, upper);
+        return sample_text(s, lower, upper_body->system_body());
       }
 
-      void attach(dem::MoreauJean &mj) override
-      {
-        if (body)
-          mj.attach(*body, half_disc_diameter, {0, -1}, prm.shear.length);
-      }
+      void attach(dem::MoreauJean &mj) override { upper_body->attach(mj); }
 
       std::vector<std::string> write_fields(const std::string &dir, unsigned int index) const override
       {
-        if (body)
-          return {body->write_fields(dir, index)};
-        return {};
+        return upper_body->write_fields(dir, index);
       }
 
       void measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj, const dem::StepReport &r,
@@ -129,9 +111,9 @@ namespace tribo::app
         const double F     = normal_force;
         double       ke_tb = 0;
         for (std::size_t b = 0; b < s.bodies.size(); ++b)
-          if (b != lower && b != upper)
+          if (b != lower && b != upper_body->system_body())
             ke_tb += s.bodies[b].kinetic_energy();
-        const Upper  ub  = upper_state(s, power);
+        const UpperState ub = upper_body->state(s, power);
         const double gap = ub.y - s.bodies[lower].position.y();
         const double surface_gap = ub.surface - (s.bodies[lower].position.y() + 0.5 * lower_wall_diameter);
         if (surface_gap < 0)
@@ -166,8 +148,8 @@ namespace tribo::app
           ("power_dissipated", -r.power_contacts)("kinetic_energy_third_body", ke_tb)
           ("kinetic_energy_upper_wall", ub.kinetic_energy)
           ("solid_fraction", grain_area(s) / (surface_gap * k.length))
-          ("elastic_energy_upper_body", ub.elastic_energy)("power_damping_upper_body", r.boundary_dissipation)
-          ("upper_body_face_shift", face_shift());
+          ("elastic_energy_upper_body", ub.stored_energy)("power_damping_upper_body", r.boundary_dissipation)
+          ("upper_body_face_shift", upper_body->face_shift());
       }
 
       void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
@@ -217,7 +199,7 @@ namespace tribo::app
         j.set("normal_force_mean", stat("lower_wall_normal_force").first);
         j.set("normal_force_stderr", stderr_of("lower_wall_normal_force"));
         j.set("normal_force_target", k.pressure * k.length);
-        const double h_tb = stat("gap").first - (upper_y_to_surface + 0.5 * lower_wall_diameter);
+        const double h_tb = stat("gap").first - (upper_body->y_to_surface() + 0.5 * lower_wall_diameter);
         j.set("third_body_thickness", h_tb);
         j.set("third_body_thickness_stderr", stderr_of("gap"));
         j.set("solid_fraction_mean", stat("solid_fraction").first);
@@ -230,8 +212,8 @@ namespace tribo::app
           for (const double x : shift)
             largest = std::max(largest, std::abs(x));
           j.set("face_shift_max", largest);
-          j.set("face_shift_in_half_discs",
-                half_disc_diameter > 0 ? stat("upper_body_face_shift").first / half_disc_diameter : 0.0);
+          const double half_disc = upper_body->half_disc_diameter();
+          j.set("face_shift_in_half_discs", half_disc > 0 ? stat("upper_body_face_shift").first / half_disc : 0.0);
         }
         j.set("cohesion_number", prm.law.cohesion / (k.pressure * mean_grain_diameter));
         if (!sliding)
@@ -269,7 +251,7 @@ namespace tribo::app
           const auto   first    = std::lower_bound(time.begin(), time.end(), start) - time.begin();
           const auto   last     = time.size() - 1;
           const auto   energy   = [&](std::size_t i) {
-            return e_grains[i] + (body ? e_body_k[i] + e_body_s[i] : 0.0);
+            return e_grains[i] + (upper_body->in_energy_balance() ? e_body_k[i] + e_body_s[i] : 0.0);
           };
           const double span     = time[last] - time[first];
           const double rate     = span > 0 ? (energy(last) - energy(first)) / span : 0.0;
@@ -308,8 +290,7 @@ namespace tribo::app
         random << rng;
         ar << random.str() << steps_done << sliding << normal_force << block_steps;
         profiles->save(ar);
-        if (body)
-          body->save(ar);
+        upper_body->save(ar);
       }
 
       void load(CheckpointIn &ar) override
@@ -319,62 +300,24 @@ namespace tribo::app
         std::istringstream is(random);
         is >> rng;
         profiles->load(ar);
-        if (body)
-          body->load(ar);
+        upper_body->load(ar);
       }
 
     private:
-      /// What the statistics need from the upper first body, whatever its model.
-      struct Upper
+      /// The upper first body of Shear cell/Upper body model, its surface at @p surface
+      /// (m) when deformable; @p wall makes the rigid one, a clump added to @p s with
+      /// its mean disc diameter.
+      void place_upper_body(dem::ParticleSystem &s, double surface,
+                            const std::function<std::pair<unsigned int, double>()> &wall)
       {
-        double y, vy;          ///< wall centre line (rigid) or mean bottom face (deformable), m and m/s
-        double surface;        ///< the surface the grains touch, m
-        double power;          ///< power of its external load over the step, W/m
-        double kinetic_energy; ///< J/m
-        double elastic_energy; ///< stored energy, J/m (0 for the rigid wall)
-      };
-
-      Upper upper_state(const dem::ParticleSystem &s, const std::vector<double> &power) const
-      {
-        if (upper != LayerProfiles::no_body)
+        const auto &k = prm.shear;
+        if (k.upper_body.model != "rigid")
           {
-            const auto &b = s.bodies[upper];
-            return {b.position.y(), b.velocity.y(), b.position.y() - upper_y_to_surface, power[upper],
-                    b.kinetic_energy(), 0.0};
+            upper_body = make_deformable_upper_body(k.upper_body, surface);
+            return;
           }
-        const double y = body->mean_bottom_y();
-        return {y, body->mean_bottom_vy(), y - upper_y_to_surface, body->external_power(), body->kinetic_energy(),
-                body->stored_energy()};
-      }
-
-      /// Mean x-displacement of the deformable upper body's contact face since the start,
-      /// sum_i (x_i - x_i(0)) / n over its chain nodes (minimum image), m; 0 for the rigid
-      /// wall, whose x is imposed. About tau H / G in steady shear.
-      double face_shift() const
-      {
-        if (!body)
-          return 0;
-        const double L = prm.shear.length;
-        double       sum = 0;
-        for (unsigned int i = 0; i < face_start.size(); ++i)
-          {
-            const double dx = body->node_position(i).x() - face_start[i];
-            sum += dx - L * std::round(dx / L);
-          }
-        return sum / face_start.size();
-      }
-
-      /// The deformable upper body with its bottom face at @p bottom (m).
-      void build_deformable_upper_body(double bottom)
-      {
-        const auto                   &k = prm.shear;
-        coupling::FirstBodyParameters b = k.upper_body;
-        half_disc_diameter   = k.upper_body.half_disc_diameter > 0 ? k.upper_body.half_disc_diameter : k.length / coupling::chain_nodes(b);
-        b.bottom             = bottom + 0.5 * half_disc_diameter;
-        upper_y_to_surface   = 0.5 * half_disc_diameter;
-        body                 = coupling::make_first_body(b);
-        for (unsigned int i = 0; i < body->n_nodes(); ++i)
-          face_start.push_back(body->node_position(i).x());
+        const auto [clump, diameter] = wall();
+        upper_body = make_rigid_upper_wall(s, clump, k.density, k.upper_body_thickness, k.length, 0.5 * diameter);
       }
 
       double draw_diameter()
@@ -385,9 +328,9 @@ namespace tribo::app
       }
 
       /// A rough wall: discs of drawn sizes (or all of Shear cell/Wall disc diameter)
-      /// spread evenly along the period at height y;
-      /// its mean disc diameter goes to lower_wall_diameter (both walls draw alike).
-      unsigned int add_wall(dem::ParticleSystem &s, double y)
+      /// spread evenly along the period at height y; returns the clump and its mean disc
+      /// diameter (both walls draw alike).
+      std::pair<unsigned int, double> add_wall(dem::ParticleSystem &s, double y)
       {
         const auto        &k = prm.shear;
         // 0 wall discs: about L/d of them (d the mean or the given wall disc diameter),
@@ -404,11 +347,7 @@ namespace tribo::app
             centres[i] = {(i + 0.5) * k.length / n, y};
           }
         const double mean_diameter = 2 * std::accumulate(radii.begin(), radii.end(), 0.0) / n;
-        if (s.bodies.empty())
-          lower_wall_diameter = mean_diameter;
-        else
-          upper_y_to_surface = 0.5 * mean_diameter;
-        return s.add_clump(centres, radii, k.density);
+        return {s.add_clump(centres, radii, k.density), mean_diameter};
       }
 
       /// Grains on a loose triangular lattice (neighbours 1.02 d_max apart) between two
@@ -417,7 +356,7 @@ namespace tribo::app
       {
         const auto  &k     = prm.shear;
         const double d_max = k.mean_diameter * (1 + k.diameter_spread);
-        lower              = add_wall(s, 0.0);
+        std::tie(lower, lower_wall_diameter) = add_wall(s, 0.0);
         for (auto &d : s.bodies[lower].drive)
           d = dem::Drive::velocity;
         const double       pitch   = 1.02 * d_max;
@@ -432,10 +371,7 @@ namespace tribo::app
                        0.5 * draw_diameter(), k.density);
           }
         const double upper_y = d_max + 0.5 * pitch + (rows - 1) * dy + pitch;
-        if (k.upper_body.model != "rigid")
-          build_deformable_upper_body(upper_y - 0.5 * lower_wall_diameter);
-        else
-          add_upper_wall(s, add_wall(s, upper_y));
+        place_upper_body(s, upper_y - 0.5 * lower_wall_diameter, [&]() { return add_wall(s, upper_y); });
       }
 
       /// The discs of Shear cell/Sample file (app/sample_file.h): its walls, or generated
@@ -483,7 +419,7 @@ namespace tribo::app
           std::tie(lower, lower_wall_diameter) = wall_of(Body::lower_wall);
         else
           {
-            lower = add_wall(s, 0.0);
+            std::tie(lower, lower_wall_diameter) = add_wall(s, 0.0);
             s.bodies[lower].position.y() += bottom - clearance;
           }
         for (auto &d : s.bodies[lower].drive)
@@ -495,47 +431,25 @@ namespace tribo::app
               s.bodies[b].velocity     = d.velocity;
               s.bodies[b].spin         = d.spin;
             }
-        if (k.upper_body.model != "rigid")
+        // A deformable body's surface where the upper wall's was, or just clear of the
+        // grains; the rigid wall from the sample's rows, or generated above the grains.
+        double surface = top + 0.01 * mean_diameter_of(k.sample);
+        if (upper_given)
           {
-            // The deformable body's surface where the upper wall's was, or just clear of
-            // the grains.
-            double surface = top + 0.01 * mean_diameter_of(k.sample);
-            if (upper_given)
-              {
-                double y = 0, r = 0;
-                int    n = 0;
-                for (const SampleDisc &d : k.sample)
-                  if (d.body == Body::upper_wall)
-                    {
-                      y += d.centre.y();
-                      r += d.radius;
-                      ++n;
-                    }
-                surface = (y - r) / n;
-              }
-            build_deformable_upper_body(surface);
+            double y = 0, r = 0;
+            int    n = 0;
+            for (const SampleDisc &d : k.sample)
+              if (d.body == Body::upper_wall)
+                {
+                  y += d.centre.y();
+                  r += d.radius;
+                  ++n;
+                }
+            surface = (y - r) / n;
           }
-        else if (upper_given)
-          {
-            auto [wall, diameter] = wall_of(Body::upper_wall);
-            upper_y_to_surface    = 0.5 * diameter;
-            add_upper_wall(s, wall);
-          }
-        else
-          add_upper_wall(s, add_wall(s, top + clearance));
-      }
-
-      /// Make @p wall the upper wall: free in y under the load, with the mass of the
-      /// first body it stands for.
-      void add_upper_wall(dem::ParticleSystem &s, unsigned int wall)
-      {
-        const auto &k = prm.shear;
-        upper         = wall;
-        auto &u       = s.bodies[upper];
-        u.drive       = {{dem::Drive::velocity, dem::Drive::force, dem::Drive::velocity}};
-        const double discs_mass = u.mass;
-        u.mass                  = k.density * k.upper_body_thickness * k.length;
-        u.inertia *= u.mass / discs_mass;
+        place_upper_body(s, surface, [&]() {
+          return upper_given ? wall_of(Body::upper_wall) : add_wall(s, top + clearance);
+        });
       }
 
       static double mean_diameter_of(const std::vector<SampleDisc> &sample)
@@ -550,25 +464,20 @@ namespace tribo::app
       {
         double a = 0;
         for (const auto &d : s.discs)
-          if (d.body != lower && d.body != upper)
+          if (d.body != lower && d.body != upper_body->system_body())
             a += M_PI * d.radius * d.radius;
         return a;
       }
 
       std::mt19937                   rng;
-      unsigned int                   lower = 0, upper = LayerProfiles::no_body;
+      unsigned int                   lower = 0;
       unsigned long                  steps_done = 0;
       /// Steps per profile sample, fixed at the first shearing step (0 before).
       unsigned long                  block_steps = 0;
       bool                           sliding    = false; ///< the lower wall has started sliding
       double                         normal_force = 0;   ///< P L at the current ramp, N/m
       double                         lower_wall_diameter = 0, mean_grain_diameter = 0;
-      /// From the upper body's reference height (ub.y) down to the surface the grains
-      /// touch: the upper wall's mean disc radius, or the half-disc radius.
-      double                         upper_y_to_surface = 0;
-      double                         half_disc_diameter = 0;
-      std::unique_ptr<coupling::FirstBody> body; ///< deformable upper body, if any
-      std::vector<double>            face_start; ///< x of its chain nodes at the start, m
+      std::unique_ptr<UpperBody>     upper_body; ///< rigid wall or deformable body
       std::unique_ptr<LayerProfiles> profiles;
       SteadyState                    steady;
       std::string                    averaging; ///< the log line of averaging_note()
