@@ -84,12 +84,15 @@ namespace tribo::dem
     if (contacts.empty())
       return report;
     require_frictionless(law, "MPRGP");
-    const FrictionlessProblem lcp(contacts, state);
+    // The walls (bodies with many contacts) as low-rank terms: A' + U'U'^T, so that a
+    // product costs O(nnz(A') + n k) instead of the walls' dense blocks.
+    const FrictionlessProblem lcp(contacts, state, true);
     const Index               n = lcp.size();
     // The scaled problem (file comment).
     FrictionlessProblem::Scaled       scaled   = lcp.scaled();
     const Eigen::VectorXd            &inv_root = scaled.inv_root;
     const Eigen::SparseMatrix<double> &A        = scaled.A;
+    const Eigen::MatrixXd            &U        = scaled.U;
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
     double norm_bound        = 0; // ||A'|| <= max absolute column sum
@@ -100,18 +103,27 @@ namespace tribo::dem
           sum += std::abs(a.value());
         norm_bound = std::max(norm_bound, sum);
       }
+    norm_bound += U.squaredNorm(); // ||U'U'^T|| <= ||U'||_F^2
     const double          alpha     = 1.9 / norm_bound;
     const double          gamma2    = 1.0; // Gamma^2
     const unsigned int    threads   = prm.threads;
 
-    // Column j of the symmetric A' is its row j: (A' v)_j from column j alone.
-    const int    *start = A.outerIndexPtr();
-    const int    *row   = A.innerIndexPtr();
-    const double *value = A.valuePtr();
-    auto          times = [&](const Eigen::VectorXd &v, Index j) {
+    // Column j of the symmetric A' is its row j: ((A' + U'U'^T) v)_j from column j alone,
+    // once Ut_v = U'^T v is known (set_low_rank_product).
+    const int      *start = A.outerIndexPtr();
+    const int      *row   = A.innerIndexPtr();
+    const double   *value = A.valuePtr();
+    Eigen::VectorXd Ut_v(U.cols());
+    auto            set_low_rank_product = [&](const Eigen::VectorXd &v) {
+      if (U.cols() > 0)
+        Ut_v.noalias() = U.transpose() * v;
+    };
+    auto times = [&](const Eigen::VectorXd &v, Index j) {
       double sum = 0;
       for (int k = start[j]; k < start[j + 1]; ++k)
         sum += value[k] * v[row[k]];
+      for (Index k = 0; k < U.cols(); ++k)
+        sum += U(j, k) * Ut_v[k];
       return sum;
     };
 
@@ -139,6 +151,7 @@ namespace tribo::dem
     // g = A'y + b, then the split; p = phi.
     auto gradient_and_split = [&]() {
       ++report.iterations;
+      set_low_rank_product(y);
       return over_chunks<SplitSums>(n, threads, [&](Index first, Index last) {
         SplitSums s;
         for (Index j = first; j < last; ++j)
@@ -153,6 +166,7 @@ namespace tribo::dem
     // Ap = A' d and the product sums along d.
     auto product = [&](const Eigen::VectorXd &d) {
       ++report.iterations;
+      set_low_rank_product(d);
       return over_chunks<ProductSums>(n, threads, [&](Index first, Index last) {
         ProductSums s;
         for (Index j = first; j < last; ++j)

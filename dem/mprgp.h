@@ -8,7 +8,10 @@
 ///
 /// Preconditioning by the diagonal D of A, as a change of variables y = D^(1/2) x:
 /// the problem in y has A' = D^(-1/2) A D^(-1/2) (unit diagonal), b' = D^(-1/2) b and the
-/// same bounds y >= 0; the gradient is g = A' y + b' = D^(-1/2) w.
+/// same bounds y >= 0; the gradient is g = A' y + b' = D^(-1/2) w. The walls (bodies with
+/// more than LowRankBodies::contact_limit contacts, dem/delassus.h) are kept out of the
+/// sparse matrix as low-rank columns, A' = A'_sparse + U'U'^T: a product then costs
+/// O(nnz(A'_sparse) + n k) (k: the walls' free dofs) instead of a dense block per wall.
 /// With F = {i : y_i > 0} (free) and the others active, the free gradient phi_i = g_i on
 /// F, the chopped gradient beta_i = min(g_i, 0) off F, and the reduced free gradient
 /// phi~_i = min(y_i / alpha, g_i) on F, each iteration is one of
@@ -17,7 +20,7 @@
 ///   iterate) and the CG step length g.p / p.A'p keeps y >= 0;
 /// - an expansion step when it does not: to the bound along p, then the projected
 ///   gradient step y <- max(0, y - alpha phi(y)) with fixed length alpha = 1.9 / ||A'||
-///   (||A'|| bounded by its largest absolute row sum);
+///   (||A'|| bounded by the largest absolute row sum of its sparse part plus ||U'||_F^2);
 /// - a proportioning step along beta (exact line search) when the iterate is not
 ///   proportional: contacts pushed closed by the others leave the active set.
 /// Gamma = 1. f decreases at every step (Dostál 2009, "Optimal quadratic programming

@@ -182,10 +182,11 @@ TEST(ContactSolvers, WallsAsLowRankColumnsAddUpToTheOperator)
     }
 }
 
-TEST(ContactSolvers, InteriorPointWithTheWallAsLowRankMatchesConvergedNlgs)
+TEST(ContactSolvers, GlobalMethodsWithTheWallAsLowRankMatchConvergedNlgs)
 {
   // 36 columns: the upper wall carries more than 64 contacts, so the interior-point
-  // method solves through Sherman-Morrison-Woodbury (dem/delassus.h).
+  // method solves through Sherman-Morrison-Woodbury and MPRGP multiplies by
+  // A_sparse + U U^T (dem/delassus.h).
   const ParticleSystem s = hexagonal_stack(3600, 2, 36);
   {
     ParticleSystem probe = s;
@@ -199,12 +200,25 @@ TEST(ContactSolvers, InteriorPointWithTheWallAsLowRankMatchesConvergedNlgs)
   SolverParameters ipm;
   ipm.method          = SolverParameters::Method::interior_point;
   ipm.residual_target = 1e-11;
-  std::vector<SolveReport> reports;
+  SolverParameters mprgp;
+  mprgp.method          = SolverParameters::Method::mprgp;
+  mprgp.residual_target = 1e-11;
+  mprgp.max_iterations  = 100000;
   const Eigen::VectorXd v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 3);
-  const Eigen::VectorXd v      = velocities_after(s, ContactLaw{}, ipm, 3, &reports);
-  EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
-  for (const auto &r : reports)
-    EXPECT_LT(r.law_residual, 1e-7);
+  for (const SolverParameters &prm : {ipm, mprgp})
+    {
+      std::vector<SolveReport> reports;
+      const Eigen::VectorXd    v = velocities_after(s, ContactLaw{}, prm, 3, &reports);
+      EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm()) << method_name(prm.method);
+      for (const auto &r : reports)
+        {
+          EXPECT_LT(r.law_residual, 1e-7) << method_name(prm.method);
+          if (prm.method == SolverParameters::Method::mprgp) // the interior point stops at its floor
+            {
+              EXPECT_TRUE(r.converged) << method_name(prm.method);
+            }
+        }
+    }
 }
 
 TEST(ContactSolvers, LawResidualIsZeroWhenSolvedAndPositiveWhenAContactIsLeftUnsolved)
