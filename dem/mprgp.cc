@@ -109,21 +109,39 @@ namespace tribo::dem
     const unsigned int    threads   = prm.threads;
 
     // Column j of the symmetric A' is its row j: ((A' + U'U'^T) v)_j from column j alone,
-    // once Ut_v = U'^T v is known (set_low_rank_product).
-    const int      *start = A.outerIndexPtr();
-    const int      *row   = A.innerIndexPtr();
-    const double   *value = A.valuePtr();
+    // once Ut_v = U'^T v is known (set_low_rank_product). U' is nonzero only in the rows
+    // of the walls' contacts: kept as rows (u_start, u_column, u_value) so that the
+    // low-rank part costs O(wall contacts) per product.
+    const int          *start = A.outerIndexPtr();
+    const int          *row   = A.innerIndexPtr();
+    const double       *value = A.valuePtr();
+    std::vector<Index>  u_start(n + 1, 0), u_rows, u_column;
+    std::vector<double> u_value;
+    for (Index j = 0; j < n; ++j)
+      {
+        for (Index k = 0; k < U.cols(); ++k)
+          if (U(j, k) != 0)
+            {
+              u_column.push_back(k);
+              u_value.push_back(U(j, k));
+            }
+        u_start[j + 1] = static_cast<Index>(u_value.size());
+        if (u_start[j + 1] > u_start[j])
+          u_rows.push_back(j);
+      }
     Eigen::VectorXd Ut_v(U.cols());
     auto            set_low_rank_product = [&](const Eigen::VectorXd &v) {
-      if (U.cols() > 0)
-        Ut_v.noalias() = U.transpose() * v;
+      Ut_v.setZero();
+      for (const Index j : u_rows)
+        for (Index q = u_start[j]; q < u_start[j + 1]; ++q)
+          Ut_v[u_column[q]] += u_value[q] * v[j];
     };
     auto times = [&](const Eigen::VectorXd &v, Index j) {
       double sum = 0;
       for (int k = start[j]; k < start[j + 1]; ++k)
         sum += value[k] * v[row[k]];
-      for (Index k = 0; k < U.cols(); ++k)
-        sum += U(j, k) * Ut_v[k];
+      for (Index q = u_start[j]; q < u_start[j + 1]; ++q)
+        sum += u_value[q] * Ut_v[u_column[q]];
       return sum;
     };
 
