@@ -377,12 +377,7 @@ namespace tribo::app
 
     private:
       /// Distance between horizontal layers of a lattice of spacing @p a (m).
-      double layer_spacing(double a) const
-      {
-        if (p.lattice == sph::LatticeType::cubic)
-          return a;
-        return dim == 2 ? a * std::sqrt(3.0) / 2 : a * std::sqrt(2.0 / 3.0);
-      }
+      double layer_spacing(double a) const { return sph::layer_spacing<dim>(p.lattice, a); }
 
       /// Box of the lengths "Lx, Ly, Lz" (2D: Lx and Lz).
       Tensor<1, dim> box(const std::array<double, 3> &l) const
@@ -453,80 +448,7 @@ namespace tribo::app
         if (p.surface != Surface::tilted && p.surface != Surface::twisted)
           return sph::lattice_points<dim>(p.lattice, Tensor<1, dim>(), size, a);
         const unsigned int axis = p.surface == Surface::tilted ? dim - 1 : 1;
-        const double       diag = size.norm();
-        Tensor<1, dim>     big_origin, big = size;
-        for (unsigned int d : {0U, axis})
-          {
-            big[d]        = size[d] + 2 * diag;
-            big_origin[d] = -diag;
-          }
-        auto pts = sph::lattice_points<dim>(p.lattice, big_origin, big, a);
-        sph::tilt(pts, size / 2, p.angle, axis);
-        std::vector<Tensor<1, dim>> kept;
-        for (const auto &x : pts)
-          {
-            bool in = true;
-            for (unsigned int d = 0; d < dim; ++d)
-              in = in && x[d] >= 0 && x[d] < size[d];
-            if (in)
-              kept.push_back(x);
-          }
-        return kept;
-      }
-
-      /// The block's rest position: shift = centre + o + z e_vertical where z is the lowest
-      /// height with every block-substrate distance >= d, the range of f1 (zero force), and
-      /// the horizontal offset o (a grid of 8 per axis over one spacing @p a) makes z lowest
-      /// (Block rest = valleys) or highest (tips: the lattices stacked, each contact particle
-      /// d above a substrate particle). For a pair at horizontal distance rho < d the block's
-      /// particle may come down to z_j + sqrt(d^2 - rho^2); @p period > 0: x periodic.
-      Tensor<1, dim> placement(const std::vector<Tensor<1, dim>> &sub, const std::vector<Tensor<1, dim>> &blk,
-                               const Tensor<1, dim> &centre, double a, double period) const
-      {
-        const double d = p.range_ratio * a;
-        double       sub_top = -1e300, blk_bottom = 1e300;
-        for (const auto &x : sub)
-          sub_top = std::max(sub_top, x[dim - 1]);
-        for (const auto &x : blk)
-          blk_bottom = std::min(blk_bottom, x[dim - 1]);
-        std::vector<Tensor<1, dim>> near_sub, near_blk; // the layers that can touch
-        for (const auto &x : sub)
-          if (x[dim - 1] > sub_top - 2 * d)
-            near_sub.push_back(x);
-        for (const auto &x : blk)
-          if (x[dim - 1] < blk_bottom + 2 * d)
-            near_blk.push_back(x);
-        const unsigned int n_grid = 8;
-        Tensor<1, dim>     best;
-        const double       sign = p.rest_on_tips ? -1 : 1; // minimise sign z
-        best[dim - 1] = sign * 1e300;
-        for (unsigned int gx = 0; gx < n_grid; ++gx)
-          for (unsigned int gy = 0; gy < (dim == 3 ? n_grid : 1U); ++gy)
-            {
-              Tensor<1, dim> shift = centre;
-              shift[0] += gx * a / n_grid;
-              if (dim == 3)
-                shift[1] += gy * a / n_grid;
-              // Lowest z such that the block's bottom is at z: max over the constraints.
-              double z = sub_top + d - blk_bottom - 2 * d;
-              for (const auto &xb : near_blk)
-                for (const auto &xs : near_sub)
-                  {
-                    Tensor<1, dim> r = xb + shift - xs;
-                    if (period > 0)
-                      r[0] -= period * std::nearbyint(r[0] / period);
-                    r[dim - 1] = 0;
-                    const double rho2 = r.norm_square();
-                    if (rho2 < d * d)
-                      z = std::max(z, xs[dim - 1] + std::sqrt(d * d - rho2) - xb[dim - 1]);
-                  }
-              if (sign * z < sign * best[dim - 1] - 1e-12 * a)
-                {
-                  best          = shift;
-                  best[dim - 1] = z;
-                }
-            }
-        return best;
+        return sph::rotated_lattice_points<dim>(p.lattice, size, a, p.angle, axis);
       }
 
       /// Builds both bodies, the load, the fixed bottom, the boundary law, the damping
@@ -546,7 +468,9 @@ namespace tribo::app
         centre[0] = 0.5 * (sub_size[0] - blk_size[0]);
         if (dim == 3)
           centre[1] = 0.5 * (sub_size[1] - blk_size[1]);
-        const Tensor<1, dim> shift = placement(sub, blk, centre, a_s, p.periodic ? sub_size[0] : 0.0);
+        // At rest where the spring law f1 of range d = ratio a_s vanishes (Block rest).
+        const Tensor<1, dim> shift = sph::rest_shift(sub, blk, centre, a_s, p.range_ratio * a_s,
+                                                     p.periodic ? sub_size[0] : 0.0, p.rest_on_tips);
         for (auto &x : blk)
           x += shift;
         double sub_top = -1e300, blk_bottom = 1e300;
