@@ -16,58 +16,65 @@ namespace tribo::app
       return make_nscd_simulation(p, log);
     }
 
-#ifdef TRIBO_WITH_SPH_SCENES
-    std::unique_ptr<Simulation> make_sph(const ParameterFile &f, const CaseParameters &, Log &log)
+    /// Gives the row of scene @p name (a module's scene, in this build) its subsections
+    /// @p declare, its @p check and its factory @p make.
+    void attach(std::vector<SceneEntry> &table, const std::string &name,
+                const std::vector<void (*)(dealii::ParameterHandler &)> &declare,
+                void (*check)(const ParameterFile &),
+                std::unique_ptr<Simulation> (*make)(const ParameterFile &, const CaseParameters &, Log &))
     {
-      return make_sph_simulation(f, log);
+      for (SceneEntry &row : table)
+        if (row.name == name)
+          {
+            row.declare = declare;
+            row.check   = check;
+            row.make    = make;
+          }
     }
-    /// An SPH scene: its subsections, check and factory.
-    SceneEntry sph_scene(const std::string &name, const std::string &description)
-    {
-      return {name, description, "TRIBO_WITH_SPH", declare_sph_scene_parameters, check_sph_scene, make_sph};
-    }
-#else
-    SceneEntry sph_scene(const std::string &name, const std::string &description)
-    {
-      return {name, description, "TRIBO_WITH_SPH"};
-    }
-#endif
 
-#ifdef TRIBO_WITH_MLP_SCENES
-    std::unique_ptr<Simulation> make_mlp(const ParameterFile &f, const CaseParameters &, Log &log)
+    /// The rows of every scene; those of the particle modules get their hooks only when
+    /// built (app/particle_scenes.h).
+    std::vector<SceneEntry> make_table()
     {
-      return make_mlp_simulation(f, log);
-    }
-    /// An MLP scene: its subsections, check and factory.
-    SceneEntry mlp_scene(const std::string &name, const std::string &description)
-    {
-      return {name, description, "TRIBO_WITH_MLP", declare_mlp_scene_parameters, check_mlp_scene, make_mlp};
-    }
-#else
-    SceneEntry mlp_scene(const std::string &name, const std::string &description)
-    {
-      return {name, description, "TRIBO_WITH_MLP"};
-    }
+      std::vector<SceneEntry> table = {
+        {"collision", "two discs, Cao et al. 2011 Fig. 8", "", {}, nullptr, make_nscd},
+        {"shear",
+         "the third-body shear cell of Cao et al. 2011: a periodic layer of discs compacted, then sheared, "
+         "between two rough walls",
+         "", {}, nullptr, make_nscd},
+        {"sph_slider", "the SPH slider on a substrate of Maveyraud et al. 1999, subsection SPH slider",
+         "TRIBO_WITH_SPH", {}, nullptr, nullptr},
+        {"sph_plate", "the SPH cantilever-plate check, subsection SPH plate", "TRIBO_WITH_SPH", {}, nullptr,
+         nullptr},
+        {"mlp_ordering",
+         "movable lattice particles of Popov and Filippov 2006 ordering from random positions, "
+         "subsections MLP and MLP ordering",
+         "TRIBO_WITH_MLP", {}, nullptr, nullptr},
+        {"mlp_compression", "an MLP slab compressed between two tractions, subsections MLP and MLP compression",
+         "TRIBO_WITH_MLP", {}, nullptr, nullptr},
+        {"mlp_beams", "two MLP beams in contact under a transverse traction, subsections MLP and MLP beams",
+         "TRIBO_WITH_MLP", {}, nullptr, nullptr}};
+#ifdef TRIBO_WITH_SPH_SCENES
+      attach(table, "sph_slider", {declare_sph_slider_parameters}, check_sph_slider, make_sph_slider);
+      attach(table, "sph_plate", {declare_sph_plate_parameters}, check_sph_plate, make_sph_plate);
 #endif
+#ifdef TRIBO_WITH_MLP_SCENES
+      attach(table, "mlp_ordering",
+             {declare_mlp_parameters, declare_mlp_ordering_parameters}, check_mlp_ordering,
+             make_mlp_ordering);
+      attach(table, "mlp_compression",
+             {declare_mlp_parameters, declare_mlp_compression_parameters}, check_mlp_compression,
+             make_mlp_compression);
+      attach(table, "mlp_beams",
+             {declare_mlp_parameters, declare_mlp_beams_parameters}, check_mlp_beams, make_mlp_beams);
+#endif
+      return table;
+    }
   } // namespace
 
   const std::vector<SceneEntry> &scenes()
   {
-    static const std::vector<SceneEntry> table = {
-      {"collision", "two discs, Cao et al. 2011 Fig. 8", "", nullptr, nullptr, make_nscd},
-      {"shear",
-       "the third-body shear cell of Cao et al. 2011: a periodic layer of discs compacted, then sheared, "
-       "between two rough walls",
-       "", nullptr, nullptr, make_nscd},
-      sph_scene("sph_slider", "the SPH slider on a substrate of Maveyraud et al. 1999, subsection SPH slider"),
-      sph_scene("sph_plate", "the SPH cantilever-plate check, subsection SPH plate"),
-      mlp_scene("mlp_ordering",
-                "movable lattice particles of Popov and Filippov 2006 ordering from random positions, "
-                "subsections MLP and MLP ordering"),
-      mlp_scene("mlp_compression", "an MLP slab compressed between two tractions, subsections MLP and "
-                                   "MLP compression"),
-      mlp_scene("mlp_beams", "two MLP beams in contact under a transverse traction, subsections MLP and "
-                             "MLP beams")};
+    static const std::vector<SceneEntry> table = make_table();
     return table;
   }
 
@@ -94,10 +101,11 @@ namespace tribo::app
   {
     std::vector<void (*)(dealii::ParameterHandler &)> declared;
     for (const SceneEntry &s : scenes())
-      if (s.declare && std::find(declared.begin(), declared.end(), s.declare) == declared.end())
-        {
-          s.declare(prm);
-          declared.push_back(s.declare);
-        }
+      for (const auto declare : s.declare)
+        if (std::find(declared.begin(), declared.end(), declare) == declared.end())
+          {
+            declare(prm);
+            declared.push_back(declare);
+          }
   }
 } // namespace tribo::app

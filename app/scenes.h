@@ -29,9 +29,10 @@ namespace tribo::app
     /// The CMake option that builds the scene's module, "" for the NSCD scenes (always
     /// built).
     std::string build_option;
-    /// Declares the scene's own subsections (shared by the scenes of one module: each
-    /// distinct function is called once); nullptr: none beyond the NSCD subsections.
-    void (*declare)(dealii::ParameterHandler &) = nullptr;
+    /// Declare the scene's subsections, each function one subsection (a subsection that
+    /// scenes share, such as "MLP", is the same function in their rows and is declared
+    /// once); empty: none beyond the NSCD subsections.
+    std::vector<void (*)(dealii::ParameterHandler &)> declare;
     /// Reads and checks the scene's own entries without building it (InputError naming
     /// the entry), before anything is written; nullptr: read_case_parameters() did.
     void (*check)(const ParameterFile &) = nullptr;

@@ -1,6 +1,7 @@
 #include "mlp/analysis.h"
 
 #include "core/errors.h"
+#include "mlp/interaction.h"
 
 #include <algorithm>
 #include <cmath>
@@ -124,5 +125,46 @@ namespace tribo::mlp
   double normalised_width(const Particles &particles, double initial_extent)
   {
     return extent(particles, 1) / initial_extent;
+  }
+
+  void return_force_magnitudes(const ForceField &field, const Particles &p,
+                               const Box &box, std::vector<double> &net,
+                               std::vector<double> &bond)
+  {
+    const unsigned int n = p.size();
+    std::vector<Vec2>  sum(n, Vec2::Zero());
+    std::vector<unsigned int> bonds(n, 0);
+    bond.assign(n, 0.0);
+    const double rc = field.interaction().cutoff();
+    for (const auto &[i, j] : field.neighbours().pairs())
+      {
+        const Vec2 d = box.minimum_image(p.position[j] - p.position[i]);
+        if (d.norm() >= rc)
+          continue;
+        const Vec2   f = field.interaction().return_force(d);
+        const double a = f.norm();
+        sum[i] += f;
+        sum[j] -= f;
+        bond[i] += a;
+        bond[j] += a;
+        ++bonds[i];
+        ++bonds[j];
+      }
+    net.resize(n);
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        net[i] = sum[i].norm();
+        bond[i] = bonds[i] ? bond[i] / bonds[i] : 0.0;
+      }
+  }
+
+  double mean_coordination(const ForceField &field, const Particles &p, const Box &box)
+  {
+    const double rc = field.interaction().cutoff();
+    unsigned long bonds = 0;
+    for (const auto &[i, j] : field.neighbours().pairs())
+      if (box.minimum_image(p.position[j] - p.position[i]).norm() < rc)
+        ++bonds;
+    return p.size() ? 2.0 * bonds / p.size() : 0.0;
   }
 } // namespace tribo::mlp

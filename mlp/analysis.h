@@ -1,7 +1,7 @@
 #pragma once
 /// @file Analysis of MLP configurations (paper, section 5): two-point density
 /// correlation and its Fourier transform, Gaussian-convolved density map, and
-/// the normalised width delta_h(t).
+/// the normalised width delta_h(t), the return forces of eq. (24) and the coordination.
 
 #include "mlp/particles.h"
 
@@ -9,6 +9,8 @@
 
 namespace tribo::mlp
 {
+  class ForceField; // mlp/interaction.h
+
   /// Values on a regular nx x ny grid; node (a, b) sits at
   /// (x0 + a dx, y0 + b dy) and is stored at values[b nx + a].
   struct Grid2D
@@ -50,4 +52,16 @@ namespace tribo::mlp
 
   /// Normalised width, paper eq. (23): delta_h = extent(y) / @p initial_extent.
   double normalised_width(const Particles &particles, double initial_extent);
+
+  /// Per particle, from the pairs of the current neighbour list: @p net = |sum_j F_ret,ij|
+  /// (the paper's eq. 24, N/m) and @p bond = mean over its bonds (r < r_c) of |F_ret,ij|
+  /// (N/m; 0 for a particle without bonds). F_ret is Interaction::return_force, the
+  /// force on i; in a homogeneously strained lattice the net value cancels, the bond
+  /// mean measures the rotation of the bonds from the lattice axes.
+  void return_force_magnitudes(const ForceField &field, const Particles &p,
+                               const Box &box, std::vector<double> &net,
+                               std::vector<double> &bond);
+
+  /// Mean number of bonds (pairs closer than r_c) per particle, 2 n_bonds / N.
+  double mean_coordination(const ForceField &field, const Particles &p, const Box &box);
 } // namespace tribo::mlp

@@ -86,6 +86,14 @@ namespace tribo::sph
   }
 
   template <int dim>
+  double layer_spacing(LatticeType type, double a)
+  {
+    if (type == LatticeType::cubic)
+      return a;
+    return dim == 2 ? a * std::sqrt(3.0) / 2 : a * std::sqrt(2.0 / 3.0);
+  }
+
+  template <int dim>
   void tilt(std::vector<Tensor<1, dim>> &points, const Tensor<1, dim> &centre, double angle,
             unsigned int axis)
   {
@@ -99,6 +107,80 @@ namespace tribo::sph
         p[0] = centre[0] + c * dx - s * dz;
         p[v] = centre[v] + s * dx + c * dz;
       }
+  }
+
+  template <int dim>
+  std::vector<Tensor<1, dim>> rotated_lattice_points(LatticeType type, const Tensor<1, dim> &size, double a,
+                                                     double angle, unsigned int axis)
+  {
+    const double       diag = size.norm();
+    Tensor<1, dim>     big_origin, big = size;
+    for (unsigned int d : {0U, axis})
+      {
+        big[d]        = size[d] + 2 * diag;
+        big_origin[d] = -diag;
+      }
+    auto pts = lattice_points<dim>(type, big_origin, big, a);
+    tilt(pts, size / 2, angle, axis);
+    std::vector<Tensor<1, dim>> kept;
+    for (const auto &x : pts)
+      {
+        bool in = true;
+        for (unsigned int d = 0; d < dim; ++d)
+          in = in && x[d] >= 0 && x[d] < size[d];
+        if (in)
+          kept.push_back(x);
+      }
+    return kept;
+  }
+
+  template <int dim>
+  Tensor<1, dim> rest_shift(const std::vector<Tensor<1, dim>> &lower, const std::vector<Tensor<1, dim>> &upper,
+                            const Tensor<1, dim> &centre, double a, double d, double period, bool highest)
+  {
+    double       lower_top = -1e300, upper_bottom = 1e300;
+    for (const auto &x : lower)
+      lower_top = std::max(lower_top, x[dim - 1]);
+    for (const auto &x : upper)
+      upper_bottom = std::min(upper_bottom, x[dim - 1]);
+    std::vector<Tensor<1, dim>> near_lower, near_upper; // the layers that can touch
+    for (const auto &x : lower)
+      if (x[dim - 1] > lower_top - 2 * d)
+        near_lower.push_back(x);
+    for (const auto &x : upper)
+      if (x[dim - 1] < upper_bottom + 2 * d)
+        near_upper.push_back(x);
+    const unsigned int n_grid = 8;
+    Tensor<1, dim>     best;
+    const double       sign = highest ? -1 : 1; // minimise sign z
+    best[dim - 1] = sign * 1e300;
+    for (unsigned int gx = 0; gx < n_grid; ++gx)
+      for (unsigned int gy = 0; gy < (dim == 3 ? n_grid : 1U); ++gy)
+        {
+          Tensor<1, dim> shift = centre;
+          shift[0] += gx * a / n_grid;
+          if (dim == 3)
+            shift[1] += gy * a / n_grid;
+          // Lowest z such that the upper body's bottom is at z: max over the constraints.
+          double z = lower_top + d - upper_bottom - 2 * d;
+          for (const auto &xu : near_upper)
+            for (const auto &xl : near_lower)
+              {
+                Tensor<1, dim> r = xu + shift - xl;
+                if (period > 0)
+                  r[0] -= period * std::nearbyint(r[0] / period);
+                r[dim - 1] = 0;
+                const double rho2 = r.norm_square();
+                if (rho2 < d * d)
+                  z = std::max(z, xl[dim - 1] + std::sqrt(d * d - rho2) - xu[dim - 1]);
+              }
+          if (sign * z < sign * best[dim - 1] - 1e-12 * a)
+            {
+              best          = shift;
+              best[dim - 1] = z;
+            }
+        }
+    return best;
   }
 
   template <int dim>
@@ -226,6 +308,12 @@ namespace tribo::sph
   template std::vector<Tensor<1, dim>> lattice_points<dim>(LatticeType, const Tensor<1, dim> &,   \
                                                            const Tensor<1, dim> &, double);       \
   template double volume_per_particle<dim>(LatticeType, double);                                  \
+  template double layer_spacing<dim>(LatticeType, double);                                        \
+  template std::vector<Tensor<1, dim>> rotated_lattice_points<dim>(LatticeType, const Tensor<1, dim> &, \
+                                                                   double, double, unsigned int);   \
+  template Tensor<1, dim> rest_shift<dim>(const std::vector<Tensor<1, dim>> &,                    \
+                                          const std::vector<Tensor<1, dim>> &, const Tensor<1, dim> &, \
+                                          double, double, double, bool);                          \
   template void   tilt<dim>(std::vector<Tensor<1, dim>> &, const Tensor<1, dim> &, double,        \
                             unsigned int);                                                        \
   template std::vector<unsigned int> surface_layer<dim>(const std::vector<Tensor<1, dim>> &,      \

@@ -1,7 +1,8 @@
 #pragma once
 /// @file Lattice builders for SPH blocks and their surface modifiers
 /// (Maveyraud et al. 1999, sections 2.5 and 3: tilted and incommensurate
-/// lattices, steps, holes, random heights, self-affine fractal surfaces).
+/// lattices, steps, holes, random heights, self-affine fractal surfaces), and the
+/// rest position of one body on another.
 ///
 /// The vertical axis is the last one (y in 2D, z in 3D); "top" is the largest
 /// vertical coordinate. Lengths in m, angles in rad (counter-clockwise in the
@@ -38,12 +39,39 @@ namespace tribo::sph
   template <int dim>
   double volume_per_particle(LatticeType type, double a);
 
+  /// Distance between the horizontal layers of the lattice of spacing @p a (m): a for
+  /// square/cubic, a sqrt(3)/2 between hexagonal rows (2D), a sqrt(2/3) between HCP
+  /// layers (3D).
+  template <int dim>
+  double layer_spacing(LatticeType type, double a);
+
   /// Rotates @p points by @p angle (rad, from x towards @p axis) about @p centre in the
   /// plane of x and @p axis: the vertical (dim - 1, a tilt) or, in 3D, y (1, a twist
   /// about the vertical axis).
   template <int dim>
   void tilt(std::vector<Tensor<1, dim>> &points, const Tensor<1, dim> &centre, double angle,
             unsigned int axis = dim - 1);
+
+  /// Points of the lattice of spacing @p a (m) rotated by @p angle (rad) as tilt() does,
+  /// about the centre of the box [0, size) (m), and cut to that box: the lattice fills the
+  /// box widened by its diagonal on both sides along x and @p axis before the rotation,
+  /// so that the rotated lattice covers the whole box.
+  template <int dim>
+  std::vector<Tensor<1, dim>> rotated_lattice_points(LatticeType type, const Tensor<1, dim> &size, double a,
+                                                     double angle, unsigned int axis);
+
+  /// Where a body @p upper rests on a body @p lower (points in m) when they touch through
+  /// a force of range @p d (m), zero beyond: the shift of @p upper, centre + o + z e_v
+  /// (e_v the vertical axis), where z is the lowest height with every upper-lower distance
+  /// >= d and the horizontal offset o, on a grid of 8 per horizontal axis over one spacing
+  /// @p a (m), makes z lowest (@p highest = false: the upper body in the lower one's
+  /// hollows) or highest (true: the lattices stacked, each contact point d above a point
+  /// below). A pair at horizontal distance rho < d holds the upper point at least
+  /// sqrt(d^2 - rho^2) above the lower one; only the facing layers (within 2 d of each
+  /// body's extreme height) are compared. @p period > 0: x periodic with that period (m).
+  template <int dim>
+  Tensor<1, dim> rest_shift(const std::vector<Tensor<1, dim>> &lower, const std::vector<Tensor<1, dim>> &upper,
+                            const Tensor<1, dim> &centre, double a, double d, double period, bool highest);
 
   /// Indices of the particles within @p tol (m) of the top (largest vertical
   /// coordinate; @p top = false: bottom) of @p points.

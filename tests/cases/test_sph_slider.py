@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""The SPH scenes through `tribo run` (app/scene_sph_slider.cc), checked against physics:
+"""The SPH scenes through `tribo run` (app/scenes/sph_slider.cc, sph_plate.cc), checked
+against physics:
 
 1. a 2D clamped cantilever plate oscillates at the thin-plate frequency
    omega^2 = E H^2 k^4 / (12 rho (1 - nu^2)), kL = 1.875: the SPH frequency converges to it

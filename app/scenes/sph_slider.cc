@@ -1,36 +1,31 @@
-// The SPH scenes (app/particle_scenes.h): the slider block on a substrate of Maveyraud,
-// Benz, Ouillon, Sornette and Sornette (1999) and the clamped cantilever plate used to
-// validate the elastic solver (Gray, Monaghan and Swift 2001).
+// The SPH slider scene (sph_slider): the slider block on a substrate of Maveyraud, Benz,
+// Ouillon, Sornette and Sornette (1999), an Experiment of the SPH family
+// (app/scenes/sph_family.h).
 //
 // SI units. The vertical axis is the last one (y in 2D, z in 3D); in 2D (plane strain)
 // forces are per metre of depth (N/m) and masses kg/m. Boundary forces are those of the
 // substrate on the block, upward (repulsive) positive.
 #include "app/particle_scenes.h"
+#include "app/scenes/sph_family.h"
 #include "app/steady_state.h"
 
 #include "core/errors.h"
-#include "core/output.h"
-#include "core/run_control.h"
-#include "core/serialization.h"
 #include "sph/lattice.h"
 #include "sph/solver.h"
 
-#include <deal.II/base/data_out_base.h>
-
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <map>
 #include <numeric>
 #include <sstream>
 
 namespace tribo::app
 {
+  using namespace sph_scenes;
+
   namespace
   {
-    namespace fs = std::filesystem;
     using dealii::Patterns::Anything;
     using dealii::Patterns::Bool;
     using dealii::Patterns::Double;
@@ -39,71 +34,6 @@ namespace tribo::app
     using sph::Tensor;
 
     const std::string slider_section = "SPH slider";
-    const std::string plate_section  = "SPH plate";
-
-    /// Reads and checks entries through a ParameterFile.
-    class EntryReader
-    {
-    public:
-      explicit EntryReader(const ParameterFile &f) : file(f) {}
-      /// The value of @p path as text.
-      std::string text(const std::string &path)
-      {
-        return file.get(path);
-      }
-      /// A number satisfying @p ok, else InputError "FILE:LINE: entry ... expected @p expected".
-      template <typename Check>
-      double number(const std::string &path, Check ok, const std::string &expected)
-      {
-        return file.get_checked(path, ok, expected);
-      }
-      /// An integer >= @p lowest, else InputError naming the entry.
-      long integer(const std::string &path, long lowest, const std::string &expected)
-      {
-        const long v = file.get_integer(path);
-        if (v < lowest)
-          file.fail(path, expected);
-        return v;
-      }
-      /// Three lengths "Lx, Ly, Lz" in m, each > 0.
-      std::array<double, 3> lengths(const std::string &path)
-      {
-        const std::string  value = text(path);
-        std::istringstream is(value);
-        std::array<double, 3> out{};
-        std::string           item;
-        unsigned int          n = 0;
-        while (std::getline(is, item, ','))
-          {
-            std::size_t used = 0;
-            double      v    = 0;
-            try
-              {
-                v = std::stod(item, &used);
-              }
-            catch (const std::exception &)
-              {
-                file.fail(path, "three positive lengths in m, \"Lx, Ly, Lz\" (z vertical)");
-              }
-            if (n >= 3 || !(v > 0) || item.find_first_not_of(" \t", used) != std::string::npos)
-              file.fail(path, "three positive lengths in m, \"Lx, Ly, Lz\" (z vertical)");
-            out[n++] = v;
-          }
-        if (n != 3)
-          file.fail(path, "three positive lengths in m, \"Lx, Ly, Lz\" (z vertical)");
-        return out;
-      }
-      /// Throws InputError "FILE:LINE: entry 'path' = 'value': expected @p expected".
-      [[noreturn]] void fail(const std::string &path, const std::string &expected) const
-      {
-        file.fail(path, expected);
-      }
-    private:
-      const ParameterFile &file;
-    };
-
-    auto positive     = [](double v) { return v > 0; };
-    auto non_negative = [](double v) { return v >= 0; };
 
     /// Surfaces of the slider experiment (paper's sections 3 and 4).
     enum class Surface
@@ -141,29 +71,6 @@ namespace tribo::app
       unsigned int          regions = 4;
       double                statistics_interval = 0, field_interval = 0, averaging_fraction = 0.5;
     };
-
-    /// Parameters of the cantilever plate (2D plane strain).
-    struct PlateParameters
-    {
-      sph::Material material;
-      double        length = 0, thickness = 0, spacing = 0, smoothing_ratio = 1.2, tip_velocity = 0;
-      double        alpha = 1, beta = 0.1, courant = 0.3, dt_min = 0, end_time = 0;
-      double        statistics_interval = 0, field_interval = 0;
-    };
-
-    /// Young's modulus E = 9 K G/(3 K + G) (Pa) and Poisson ratio
-    /// nu = (3 K - 2 G)/(2 (3 K + G)) of a material's small-strain moduli (K = A for Tillotson).
-    std::pair<double, double> young_and_poisson(const sph::Material &m)
-    {
-      const double K = m.bulk_modulus, G = m.shear_modulus;
-      return {9 * K * G / (3 * K + G), (3 * K - 2 * G) / (2 * (3 * K + G))};
-    }
-
-    /// The material named granite or basalt (pattern-checked).
-    sph::Material material_named(const std::string &name)
-    {
-      return name == "basalt" ? sph::Material::basalt() : sph::Material::granite();
-    }
 
     /// Reads and checks the subsection "SPH slider" (and Simulation/End time).
     SliderParameters read_slider(EntryReader &r)
@@ -231,30 +138,6 @@ namespace tribo::app
       return p;
     }
 
-    /// Reads and checks the subsection "SPH plate".
-    PlateParameters read_plate(EntryReader &r)
-    {
-      const std::string s = plate_section + "/";
-      PlateParameters   p;
-      p.material  = material_named(r.text(s + "Material"));
-      p.length    = r.number(s + "Length", positive, "a positive length in m");
-      p.thickness = r.number(s + "Thickness", positive, "a positive thickness in m");
-      p.spacing   = r.number(s + "Particle spacing", positive, "a positive particle spacing in m");
-      p.smoothing_ratio = r.number(s + "Smoothing length ratio", [](double v) { return v >= 1 && v <= 2; },
-                                   "a ratio h/a in [1, 2]");
-      p.tip_velocity = r.number(s + "Tip velocity", positive, "a positive velocity in m/s");
-      p.alpha   = r.number(s + "Artificial viscosity alpha", non_negative, "alpha >= 0");
-      p.beta    = r.number(s + "Artificial viscosity beta", non_negative, "beta >= 0");
-      p.courant = r.number(s + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
-      p.dt_min  = r.number(s + "Step floor", positive, "a positive step floor in s");
-      p.end_time = r.number("Simulation/End time", positive, "a positive end time in s");
-      p.statistics_interval = r.number(s + "Statistics interval", positive, "a positive interval in s");
-      p.field_interval = r.number(s + "Field interval", non_negative, "an interval >= 0 in s");
-      if (p.thickness < 3 * p.spacing || p.length < 3 * p.thickness)
-        r.fail(s + "Thickness", "at least 3 particle spacings and at most a third of the length");
-      return p;
-    }
-
     /// A vector along the vertical (last) axis of length @p value.
     template <int dim>
     Tensor<1, dim> vertical(double value)
@@ -263,212 +146,6 @@ namespace tribo::app
       t[dim - 1] = value;
       return t;
     }
-
-    /// VTU text of the particles: one vertex per particle with velocity (m/s), boundary
-    /// force (N, N/m in 2D; from the last rate evaluation), pressure P (Pa, compression
-    /// positive), Cauchy stress sigma = -P I + S (Pa, tension positive; in 2D also the
-    /// plane-strain sigma_zz = -P + S_zz, S_zz = -(S_xx + S_yy)), density (kg/m^3),
-    /// specific internal energy (J/kg) and body id.
-    template <int dim>
-    std::string particle_vtu(const sph::Solver<dim> &solver)
-    {
-      const auto        &s  = solver.state;
-      const auto        &k  = solver.last_rates();
-      const unsigned int n_stress = dim == 2 ? 4 : 6;
-      const unsigned int n_comp   = 2 * dim + 1 + n_stress + 3;
-      std::vector<dealii::DataOutBase::Patch<0, dim>> patches(s.size());
-      for (unsigned int i = 0; i < s.size(); ++i)
-        {
-          auto &p = patches[i];
-          for (unsigned int d = 0; d < dim; ++d)
-            p.vertices[0][d] = s.x[i][d];
-          p.patch_index = i;
-          p.data.reinit(n_comp, 1);
-          const double P = solver.materials()[s.material[i]].evaluate(s.rho[i], s.e[i]).pressure;
-          unsigned int c = 0;
-          for (unsigned int d = 0; d < dim; ++d)
-            p.data(c++, 0) = s.v[i][d];
-          for (unsigned int d = 0; d < dim; ++d)
-            p.data(c++, 0) = k.boundary_force.size() == s.size() ? k.boundary_force[i][d] : 0.0;
-          p.data(c++, 0) = P;
-          for (unsigned int a = 0; a < dim; ++a)
-            p.data(c++, 0) = s.S[i][a][a] - P;
-          if (dim == 2)
-            p.data(c++, 0) = -(s.S[i][0][0] + s.S[i][1][1]) - P;
-          for (unsigned int a = 0; a < dim; ++a)
-            for (unsigned int b = a + 1; b < dim; ++b)
-              p.data(c++, 0) = s.S[i][a][b];
-          p.data(c++, 0) = s.rho[i];
-          p.data(c++, 0) = s.e[i];
-          p.data(c++, 0) = s.body[i];
-        }
-      std::vector<std::string> names(dim, "velocity");
-      names.insert(names.end(), dim, "boundary_force");
-      names.push_back("pressure");
-      const std::vector<std::string> stress =
-        dim == 2 ? std::vector<std::string>{"sigma_xx", "sigma_yy", "sigma_zz", "sigma_xy"}
-                 : std::vector<std::string>{"sigma_xx", "sigma_yy", "sigma_zz", "sigma_xy", "sigma_xz", "sigma_yz"};
-      names.insert(names.end(), stress.begin(), stress.end());
-      for (const char *n : {"density", "internal_energy", "body"})
-        names.push_back(n);
-      using DCI = dealii::DataComponentInterpretation::DataComponentInterpretation;
-      const std::vector<std::tuple<unsigned int, unsigned int, std::string, DCI>> vectors = {
-        {0, dim - 1, "velocity", dealii::DataComponentInterpretation::component_is_part_of_vector},
-        {dim, 2 * dim - 1, "boundary_force", dealii::DataComponentInterpretation::component_is_part_of_vector}};
-      dealii::DataOutBase::VtkFlags flags;
-      flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
-      std::ostringstream os;
-      dealii::DataOutBase::write_vtu(patches, names, vectors, flags, os);
-      return os.str();
-    }
-
-    /// What an SPH scene adds to SphSimulation, the family's part of the time loop: its
-    /// step limit, its per-step bookkeeping, its rows and its summary.
-    template <int dim>
-    class Experiment
-    {
-    public:
-      virtual ~Experiment() = default;
-      /// Largest step allowed now (to land on an event time), s.
-      virtual double step_limit(const sph::Solver<dim> &) const { return std::numeric_limits<double>::infinity(); }
-      /// Before each step (state at the start of the step).
-      virtual void before_step(sph::Solver<dim> &solver) = 0;
-      /// After a step of length @p dt.
-      virtual void after_step(sph::Solver<dim> &solver, double dt) = 0;
-      /// The scene's columns of a statistics row (after "time", "step", "dt") as (name,
-      /// value) pairs; resets the interval averages.
-      virtual void row(const sph::Solver<dim> &solver, Row &row) = 0;
-      /// Results of the run for summary.json "results" from the statistics.
-      virtual void summarize(const TimeSeries &stats, double t_end, JsonObject &results) const = 0;
-      /// Checkpoint: what the scene carries from step to step (its accumulators and phase);
-      /// its groups of particles are rebuilt with it.
-      virtual void save(CheckpointOut &ar) const = 0;
-      virtual void load(CheckpointIn &ar)        = 0;
-    };
-
-    /// Output settings of the explicit loop.
-    struct LoopSettings
-    {
-      std::string scene;
-      double      end_time = 0, statistics_interval = 0, field_interval = 0;
-    };
-
-    /// An SPH scene as the driver runs it: RK2 steps of adaptive length until the end
-    /// time, statistics rows every statistics interval of simulated time (the first at
-    /// t = 0), VTU snapshots fields/particles_NNNNN.vtu indexed in fields/particles.pvd
-    /// every field interval (0: the first and the last only).
-    template <int dim>
-    class SphSimulation : public Simulation
-    {
-    public:
-      /// The scene @p make_experiment builds on the solver @p s.
-      SphSimulation(const LoopSettings &settings, std::unique_ptr<sph::Solver<dim>> s,
-                    const std::function<std::unique_ptr<Experiment<dim>>(sph::Solver<dim> &)> &make_experiment)
-        : ls(settings)
-        , solver(std::move(s))
-        , exp(make_experiment(*solver))
-        , next_row(ls.statistics_interval)
-        , next_field(ls.field_interval > 0 ? ls.field_interval : 2 * ls.end_time)
-      {}
-
-      /// Extra integer entries of summary.json (the sizes of the scene's groups).
-      void set_counts(std::vector<std::pair<std::string, long>> c) { counts = std::move(c); }
-
-      double time() const override { return solver->time; }
-      double end_time() const override { return ls.end_time; }
-      bool   reached_end(unsigned long) const override { return solver->time >= ls.end_time * (1 - 1e-12); }
-
-      void advance(unsigned long, const std::function<void(const std::string &)> &) override
-      {
-        exp->before_step(*solver);
-        dt    = solver->step(std::min(ls.end_time - solver->time, exp->step_limit(*solver)));
-        dt_lo = std::min(dt_lo, dt);
-        dt_hi = std::max(dt_hi, dt);
-        exp->after_step(*solver, dt);
-      }
-
-      bool row(Row &row) override
-      {
-        row("dt", dt);
-        exp->row(*solver, row);
-        return true;
-      }
-      bool row_at_start() const override { return true; }
-      bool row_due(unsigned long) override
-      {
-        if (solver->time < next_row * (1 - 1e-12))
-          return false;
-        while (next_row <= solver->time * (1 + 1e-12))
-          next_row += ls.statistics_interval;
-        return true;
-      }
-      bool snapshot_due(unsigned long) override
-      {
-        if (solver->time < next_field * (1 - 1e-12))
-          return false;
-        while (next_field <= solver->time * (1 + 1e-12))
-          next_field += ls.field_interval;
-        return true;
-      }
-
-      void write_snapshot(FieldWriter &fields) override
-      {
-        char name[40];
-        std::snprintf(name, sizeof name, "particles_%05u.vtu", fields.n_indexed("particles"));
-        atomic_write((fs::path(fields.directory()) / name).string(), particle_vtu(*solver));
-        fields.index("particles", solver->time, name);
-      }
-      unsigned int n_snapshots(const FieldWriter &fields) const override { return fields.n_indexed("particles"); }
-
-      std::string resumed_line(unsigned long step) const override
-      {
-        std::ostringstream os;
-        os << "resumed at step " << step << " (t = " << solver->time << " s) of the run to " << ls.end_time << " s";
-        return os.str();
-      }
-
-      void summarize(const RunEnd &end, JsonObject &summary, RunOutputs &out) override
-      {
-        for (const auto &[name, value] : counts)
-          summary.set(name, value);
-        summary.set("dimension", long(dim));
-        summary.set("end_time", ls.end_time);
-        summary.set("dt_min", end.step ? dt_lo : 0.0);
-        summary.set("dt_max", dt_hi);
-        summary.set("last_step_limiter", solver->last_limiter());
-        summary.set("n_particles", long(solver->state.size()));
-        exp->summarize(end.statistics, solver->time, out.results);
-        out.scalars["dt_min"] = end.step ? dt_lo : 0.0;
-        out.scalars["dt_max"] = dt_hi;
-        std::ostringstream os;
-        os << end.step << " steps to t = " << solver->time << " s in " << end.wall_time << " s; step "
-           << (end.step ? dt_lo : 0.0) << " .. " << dt_hi << " s";
-        out.last_line = os.str();
-      }
-
-      // After the step number (the driver's), in this order.
-      void save(CheckpointOut &ar) const override
-      {
-        ar << dt << dt_lo << dt_hi << next_row << next_field;
-        solver->save(ar);
-        exp->save(ar);
-      }
-      void load(CheckpointIn &ar, unsigned long) override
-      {
-        ar >> dt >> dt_lo >> dt_hi >> next_row >> next_field;
-        solver->load(ar);
-        exp->load(ar);
-        if (ls.field_interval <= 0) // first and last only, whatever the end time now
-          next_field = 2 * ls.end_time;
-      }
-
-    private:
-      LoopSettings                              ls;
-      std::unique_ptr<sph::Solver<dim>>         solver;
-      std::unique_ptr<Experiment<dim>>          exp;
-      std::vector<std::pair<std::string, long>> counts;
-      double dt = 0, dt_lo = std::numeric_limits<double>::infinity(), dt_hi = 0, next_row, next_field;
-    };
 
     /// Mean of @p v over indices in @p rows.
     double mean_of(const std::vector<double> &v, const std::vector<std::size_t> &rows)
@@ -489,9 +166,6 @@ namespace tribo::app
       return rows.empty() ? 0.0 : std::sqrt(s / rows.size());
     }
 
-    // ------------------------------------------------------------------------------------
-    // The slider
-
     /// The slider experiment: a block (body 1) pressed on a substrate (body 0) by a
     /// pressure P on its top layer ramped as P (1 - exp(-t/tau)), the substrate's bottom
     /// layer fixed; from the slide start the top layer(s) of the block move horizontally
@@ -511,8 +185,12 @@ namespace tribo::app
 
       /// Load area A (m^2, m in 2D) and the nominal normal force P A (N, N/m in 2D).
       double area() const { return load_area; }
-      unsigned int n_block() const { return n_b; }
-      unsigned int n_substrate() const { return n_s; }
+
+      /// The bodies' sizes, first in summary.json.
+      std::vector<std::pair<std::string, long>> counts() const override
+      {
+        return {{"n_block", long(n_b)}, {"n_substrate", long(n_s)}};
+      }
 
       /// Lands on the slide start.
       double step_limit(const sph::Solver<dim> &solver) const override
@@ -699,12 +377,7 @@ namespace tribo::app
 
     private:
       /// Distance between horizontal layers of a lattice of spacing @p a (m).
-      double layer_spacing(double a) const
-      {
-        if (p.lattice == sph::LatticeType::cubic)
-          return a;
-        return dim == 2 ? a * std::sqrt(3.0) / 2 : a * std::sqrt(2.0 / 3.0);
-      }
+      double layer_spacing(double a) const { return sph::layer_spacing<dim>(p.lattice, a); }
 
       /// Box of the lengths "Lx, Ly, Lz" (2D: Lx and Lz).
       Tensor<1, dim> box(const std::array<double, 3> &l) const
@@ -775,80 +448,7 @@ namespace tribo::app
         if (p.surface != Surface::tilted && p.surface != Surface::twisted)
           return sph::lattice_points<dim>(p.lattice, Tensor<1, dim>(), size, a);
         const unsigned int axis = p.surface == Surface::tilted ? dim - 1 : 1;
-        const double       diag = size.norm();
-        Tensor<1, dim>     big_origin, big = size;
-        for (unsigned int d : {0U, axis})
-          {
-            big[d]        = size[d] + 2 * diag;
-            big_origin[d] = -diag;
-          }
-        auto pts = sph::lattice_points<dim>(p.lattice, big_origin, big, a);
-        sph::tilt(pts, size / 2, p.angle, axis);
-        std::vector<Tensor<1, dim>> kept;
-        for (const auto &x : pts)
-          {
-            bool in = true;
-            for (unsigned int d = 0; d < dim; ++d)
-              in = in && x[d] >= 0 && x[d] < size[d];
-            if (in)
-              kept.push_back(x);
-          }
-        return kept;
-      }
-
-      /// The block's rest position: shift = centre + o + z e_vertical where z is the lowest
-      /// height with every block-substrate distance >= d, the range of f1 (zero force), and
-      /// the horizontal offset o (a grid of 8 per axis over one spacing @p a) makes z lowest
-      /// (Block rest = valleys) or highest (tips: the lattices stacked, each contact particle
-      /// d above a substrate particle). For a pair at horizontal distance rho < d the block's
-      /// particle may come down to z_j + sqrt(d^2 - rho^2); @p period > 0: x periodic.
-      Tensor<1, dim> placement(const std::vector<Tensor<1, dim>> &sub, const std::vector<Tensor<1, dim>> &blk,
-                               const Tensor<1, dim> &centre, double a, double period) const
-      {
-        const double d = p.range_ratio * a;
-        double       sub_top = -1e300, blk_bottom = 1e300;
-        for (const auto &x : sub)
-          sub_top = std::max(sub_top, x[dim - 1]);
-        for (const auto &x : blk)
-          blk_bottom = std::min(blk_bottom, x[dim - 1]);
-        std::vector<Tensor<1, dim>> near_sub, near_blk; // the layers that can touch
-        for (const auto &x : sub)
-          if (x[dim - 1] > sub_top - 2 * d)
-            near_sub.push_back(x);
-        for (const auto &x : blk)
-          if (x[dim - 1] < blk_bottom + 2 * d)
-            near_blk.push_back(x);
-        const unsigned int n_grid = 8;
-        Tensor<1, dim>     best;
-        const double       sign = p.rest_on_tips ? -1 : 1; // minimise sign z
-        best[dim - 1] = sign * 1e300;
-        for (unsigned int gx = 0; gx < n_grid; ++gx)
-          for (unsigned int gy = 0; gy < (dim == 3 ? n_grid : 1U); ++gy)
-            {
-              Tensor<1, dim> shift = centre;
-              shift[0] += gx * a / n_grid;
-              if (dim == 3)
-                shift[1] += gy * a / n_grid;
-              // Lowest z such that the block's bottom is at z: max over the constraints.
-              double z = sub_top + d - blk_bottom - 2 * d;
-              for (const auto &xb : near_blk)
-                for (const auto &xs : near_sub)
-                  {
-                    Tensor<1, dim> r = xb + shift - xs;
-                    if (period > 0)
-                      r[0] -= period * std::nearbyint(r[0] / period);
-                    r[dim - 1] = 0;
-                    const double rho2 = r.norm_square();
-                    if (rho2 < d * d)
-                      z = std::max(z, xs[dim - 1] + std::sqrt(d * d - rho2) - xb[dim - 1]);
-                  }
-              if (sign * z < sign * best[dim - 1] - 1e-12 * a)
-                {
-                  best          = shift;
-                  best[dim - 1] = z;
-                }
-            }
-        return best;
+        return sph::rotated_lattice_points<dim>(p.lattice, size, a, p.angle, axis);
       }
 
       /// Builds both bodies, the load, the fixed bottom, the boundary law, the damping
@@ -868,7 +468,9 @@ namespace tribo::app
         centre[0] = 0.5 * (sub_size[0] - blk_size[0]);
         if (dim == 3)
           centre[1] = 0.5 * (sub_size[1] - blk_size[1]);
-        const Tensor<1, dim> shift = placement(sub, blk, centre, a_s, p.periodic ? sub_size[0] : 0.0);
+        // At rest where the spring law f1 of range d = ratio a_s vanishes (Block rest).
+        const Tensor<1, dim> shift = sph::rest_shift(sub, blk, centre, a_s, p.range_ratio * a_s,
+                                                     p.periodic ? sub_size[0] : 0.0, p.rest_on_tips);
         for (auto &x : blk)
           x += shift;
         double sub_top = -1e300, blk_bottom = 1e300;
@@ -1030,165 +632,14 @@ namespace tribo::app
       if (p.periodic && period < 3 * 2 * std::max(p.smoothing_ratio, p.range_ratio) * p.spacing *
                                    (p.surface == Surface::incommensurate ? p.ratio : 1.0))
         r.fail(slider_section + "/Substrate size", "a substrate at least 3 cut-offs long when periodic");
-      long n_block = 0, n_substrate = 0;
-      auto sim     = std::make_unique<SphSimulation<dim>>(
+      return make_simulation<dim>(
         LoopSettings{"sph_slider", p.end_time, p.statistics_interval, p.field_interval},
         std::make_unique<sph::Solver<dim>>(std::vector<sph::Material>{p.material}, slider_solver<dim>(p, period)),
-        [&](sph::Solver<dim> &solver) {
-          auto slider = std::make_unique<Slider<dim>>(p, solver, log);
-          n_block     = slider->n_block();
-          n_substrate = slider->n_substrate();
-          return slider;
-        });
-      sim->set_counts({{"n_block", n_block}, {"n_substrate", n_substrate}});
-      return sim;
-    }
-
-    // ------------------------------------------------------------------------------------
-    // The cantilever plate
-
-    /// First mode of a clamped-free beam, w(x) = cosh kx - cos kx - s (sinh kx - sin kx),
-    /// s = (cosh kL + cos kL)/(sinh kL + sin kL), kL = 1.875104 (dimensionless shape).
-    double cantilever_mode(double x, double L)
-    {
-      const double kL = 1.875104068711961, k = kL / L;
-      const double s  = (std::cosh(kL) + std::cos(kL)) / (std::sinh(kL) + std::sin(kL));
-      return std::cosh(k * x) - std::cos(k * x) - s * (std::sinh(k * x) - std::sin(k * x));
-    }
-
-    /// The cantilever plate (2D plane strain): a plate 0 <= x < L, 0 <= y < H clamped by
-    /// three fixed columns at x < 0, started with the first mode's velocity
-    /// v_y(x) = V w(x)/w(L) (V the tip velocity). Thin-plate theory:
-    /// omega^2 = E H^2 k^4/(12 rho (1 - nu^2)), kL = 1.875 (E, nu of the small-strain
-    /// moduli). The tip deflection w_tip(t) = (V/omega) sin(omega t): its first zero after
-    /// t = 0 is at pi/omega; before that the first zero of the tip velocity, pi/(2 omega).
-    class Plate : public Experiment<2>
-    {
-    public:
-      Plate(const PlateParameters &p, sph::Solver<2> &solver, Log &log) : p(p)
-      {
-        const double a = p.spacing;
-        Tensor<1, 2> origin, size;
-        origin[0] = -3 * a;
-        size[0]   = p.length + 3 * a;
-        size[1]   = p.thickness;
-        const auto pts = sph::lattice_points<2>(sph::LatticeType::cubic, origin, size, a);
-        sph::add_particles(solver.state, pts, p.material.rho0, a * a, p.smoothing_ratio * a, 0, 0);
-        sph::ImposedVelocity<2> clamp;
-        double                  x_max = -1e300;
-        for (const auto &x : pts)
-          x_max = std::max(x_max, x[0]);
-        for (unsigned int i = 0; i < pts.size(); ++i)
-          {
-            if (pts[i][0] < 0)
-              clamp.particles.push_back(i);
-            else
-              solver.state.v[i][1] = p.tip_velocity * cantilever_mode(pts[i][0], p.length) /
-                                     cantilever_mode(p.length, p.length);
-            if (pts[i][0] > x_max - 0.25 * a)
-              {
-                tip.push_back(i);
-                y0.push_back(pts[i][1]);
-              }
-          }
-        solver.imposed.push_back(clamp);
-        const auto [E, nu] = young_and_poisson(p.material);
-        const double k     = 1.875104068711961 / p.length;
-        omega = std::sqrt(E * p.thickness * p.thickness * k * k * k * k /
-                          (12 * p.material.rho0 * (1 - nu * nu)));
-        std::ostringstream os;
-        os << "sph_plate 2D " << p.material.name << ": " << pts.size() << " particles (" << clamp.particles.size()
-           << " clamped), L = " << p.length << " m, H = " << p.thickness << " m, E = " << E << " Pa, nu = " << nu
-           << "; thin-plate omega = " << omega << " 1/s (period " << 2 * M_PI / omega << " s)";
-        log(os.str());
-      }
-
-      void before_step(sph::Solver<2> &) override {}
-
-      /// Records the tip deflection (mean over the tip column, m) and velocity (m/s)
-      /// at every step and finds the first zero crossings.
-      void after_step(sph::Solver<2> &solver, double) override
-      {
-        double w = 0, v = 0;
-        tip_state(solver, w, v);
-        const double t = solver.time;
-        if (t_v0 == 0 && v_prev > 0 && v <= 0)
-          t_v0 = t_prev + (t - t_prev) * v_prev / (v_prev - v);
-        if (t_w0 == 0 && w_prev > 0 && w <= 0)
-          t_w0 = t_prev + (t - t_prev) * w_prev / (w_prev - w);
-        t_prev = t;
-        w_prev = w;
-        v_prev = v;
-      }
-
-      void row(const sph::Solver<2> &solver, Row &row) override
-      {
-        double w = 0, v = 0;
-        tip_state(solver, w, v);
-        const double ke = solver.state.kinetic_energy(), ei = solver.state.internal_energy();
-        row("tip_deflection", w)("tip_velocity", v)("kinetic_energy", ke)("internal_energy", ei)
-          ("total_energy", ke + ei);
-      }
-
-      void summarize(const TimeSeries &stats, double, JsonObject &res) const override
-      {
-        const double measured = t_w0 > 0 ? M_PI / t_w0 : t_v0 > 0 ? M_PI / (2 * t_v0) : 0.0;
-        res.set("omega_analytic", omega);
-        res.set("omega_measured", measured);
-        res.set("omega_ratio", measured / omega);
-        res.set("measured_from", t_w0 > 0 ? "tip deflection zero (t = pi/omega)"
-                                 : t_v0 > 0 ? "tip velocity zero (t = pi/(2 omega))" : "none (run too short)");
-        res.set("first_velocity_zero", t_v0);
-        res.set("first_deflection_zero", t_w0);
-        const auto w = stats.column("tip_deflection");
-        res.set("max_tip_deflection", *std::max_element(w.begin(), w.end()));
-        res.set("amplitude_thin_plate", p.tip_velocity / omega);
-        const auto e = stats.column("total_energy");
-        res.set("energy_change_ratio", e.front() > 0 ? (e.back() - e.front()) / e.front() : 0.0);
-      }
-
-      /// The tip's previous values and the zero crossings found so far.
-      void save(CheckpointOut &ar) const override { ar << t_prev << w_prev << v_prev << t_v0 << t_w0; }
-      void load(CheckpointIn &ar) override { ar >> t_prev >> w_prev >> v_prev >> t_v0 >> t_w0; }
-
-    private:
-      /// Mean vertical displacement @p w (m) and velocity @p v (m/s) of the tip column.
-      void tip_state(const sph::Solver<2> &solver, double &w, double &v) const
-      {
-        w = v = 0;
-        for (unsigned int q = 0; q < tip.size(); ++q)
-          {
-            w += solver.state.x[tip[q]][1] - y0[q];
-            v += solver.state.v[tip[q]][1];
-          }
-        w /= tip.size();
-        v /= tip.size();
-      }
-
-      PlateParameters           p;
-      std::vector<unsigned int> tip;
-      std::vector<double>       y0;
-      double                    omega = 0;
-      double t_prev = 0, w_prev = 0, v_prev = 0, t_v0 = 0, t_w0 = 0;
-    };
-
-    /// Reads "SPH plate" and builds the plate.
-    std::unique_ptr<Simulation> make_plate(EntryReader &r, Log &log)
-    {
-      const PlateParameters p = read_plate(r);
-      sph::SolverParameters s;
-      s.alpha   = p.alpha;
-      s.beta    = p.beta;
-      s.courant = p.courant;
-      s.dt_min  = p.dt_min;
-      return std::make_unique<SphSimulation<2>>(
-        LoopSettings{"sph_plate", p.end_time, p.statistics_interval, p.field_interval},
-        std::make_unique<sph::Solver<2>>(std::vector<sph::Material>{p.material}, s),
-        [&](sph::Solver<2> &solver) { return std::make_unique<Plate>(p, solver, log); });
+        [&](sph::Solver<dim> &solver) { return std::make_unique<Slider<dim>>(p, solver, log); });
     }
   } // namespace
 
-  void declare_sph_scene_parameters(dealii::ParameterHandler &prm)
+  void declare_sph_slider_parameters(dealii::ParameterHandler &prm)
   {
     prm.enter_subsection(slider_section);
     prm.declare_entry("Material", "granite", Selection("granite|basalt"),
@@ -1276,37 +727,17 @@ namespace tribo::app
                       "mu_mean and mu_std in summary.json average the last N whole lattice periods a/V within the last "
                       "fraction f of the sliding phase (the last f of it if shorter than one period), in (0, 1].");
     prm.leave_subsection();
-
-    prm.enter_subsection(plate_section);
-    prm.declare_entry("Material", "granite", Selection("granite|basalt"), "Rock of the plate.");
-    prm.declare_entry("Length", "0.2", Double(), "Free length L of the plate, m (> 0).");
-    prm.declare_entry("Thickness", "0.02", Double(), "Thickness H, m (>= 3 spacings, <= L/3).");
-    prm.declare_entry("Particle spacing", "3.333333333333333e-3", Double(), "Square-lattice spacing a, m (> 0).");
-    prm.declare_entry("Smoothing length ratio", "1.2", Double(), "h/a, in [1, 2].");
-    prm.declare_entry("Tip velocity", "0.05", Double(), "Initial tip velocity V of the first mode, m/s (> 0).");
-    prm.declare_entry("Artificial viscosity alpha", "1", Double(), "Monaghan viscosity alpha, >= 0.");
-    prm.declare_entry("Artificial viscosity beta", "0.1", Double(), "Monaghan viscosity beta, >= 0.");
-    prm.declare_entry("CFL number", "0.3", Double(), "CFL number, in (0, 1].");
-    prm.declare_entry("Step floor", "1e-12", Double(), "Smallest allowed step, s (> 0).");
-    prm.declare_entry("Statistics interval", "2e-5", Double(), "Simulated time between rows, s (> 0).");
-    prm.declare_entry("Field interval", "0", Double(), "Simulated time between VTU snapshots, s (>= 0).");
-    prm.leave_subsection();
   }
 
-  void check_sph_scene(const ParameterFile &file)
+  void check_sph_slider(const ParameterFile &file)
   {
     EntryReader r(file);
-    if (r.text("Simulation/Scene") == "sph_plate")
-      read_plate(r);
-    else
-      read_slider(r);
+    read_slider(r);
   }
 
-  std::unique_ptr<Simulation> make_sph_simulation(const ParameterFile &file, Log &log)
+  std::unique_ptr<Simulation> make_sph_slider(const ParameterFile &file, const CaseParameters &, Log &log)
   {
-    EntryReader r(file);
-    if (r.text("Simulation/Scene") == "sph_plate")
-      return make_plate(r, log);
+    EntryReader              r(file);
     const SliderParameters p = read_slider(r);
     return p.dim == 2 ? make_slider<2>(r, p, log) : make_slider<3>(r, p, log);
   }
