@@ -1,19 +1,17 @@
 #pragma once
 /// @file Scenes of the explicit particle modules (sph/, mlp/), one file each in
 /// app/scenes/, built as a Simulation that the driver (app/driver.h) runs like the NSCD
-/// scenes; their rows of the scene table (app/scenes.cc) name these functions. For each
-/// scene: declare_..._parameters declares its own subsection; check_... reads and checks
-/// its entries without running it (an InputError naming the entry otherwise: `tribo
-/// check`, and `tribo run` before it writes anything); make_... builds it (what it built
-/// goes to the log). run_case() has prepared the output directory, written original.prm,
+/// scenes. Each scene file gives its row of the scene table (app/scenes.cc) its hooks
+/// (app/scenes.h): the declaration of its own subsection, the check of its entries
+/// without running it (an InputError naming the entry otherwise: `tribo check`, and
+/// `tribo run` before it writes anything) and its factory (what it built goes to the
+/// log). run_case() has prepared the output directory, written original.prm,
 /// parameters.prm and a "running" summary.json, opened the log, and for --resume checked
 /// the checkpoint's parameters against the case.
 
-#include "app/driver.h"
+#include "app/scenes.h"
 #include "core/output.h"
 #include "core/parameter_file.h"
-
-#include <deal.II/base/parameter_handler.h>
 
 #include <memory>
 
@@ -22,34 +20,13 @@ namespace tribo::app
   struct CaseParameters; // app/case_parameters.h
 
 #ifdef TRIBO_WITH_SPH_SCENES
-  // app/scenes/sph_slider.cc: the slider on a substrate, subsection "SPH slider".
-  void                        declare_sph_slider_parameters(dealii::ParameterHandler &prm);
-  void                        check_sph_slider(const ParameterFile &file);
-  std::unique_ptr<Simulation> make_sph_slider(const ParameterFile &file, const CaseParameters &, Log &log);
-
-  // app/scenes/sph_plate.cc: the cantilever plate, subsection "SPH plate".
-  void                        declare_sph_plate_parameters(dealii::ParameterHandler &prm);
-  void                        check_sph_plate(const ParameterFile &file);
-  std::unique_ptr<Simulation> make_sph_plate(const ParameterFile &file, const CaseParameters &, Log &log);
+  SceneHooks sph_slider_hooks(); ///< app/scenes/sph_slider.cc, subsection "SPH slider"
+  SceneHooks sph_plate_hooks();  ///< app/scenes/sph_plate.cc, subsection "SPH plate"
 #endif
-
 #ifdef TRIBO_WITH_MLP_SCENES
-  /// Declare the subsection "MLP" that every MLP scene reads (app/scenes/mlp_family.cc).
-  void declare_mlp_parameters(dealii::ParameterHandler &prm);
-
-  // app/scenes/mlp_ordering.cc, subsection "MLP ordering"; the check includes the time step.
-  void                        declare_mlp_ordering_parameters(dealii::ParameterHandler &prm);
-  void                        check_mlp_ordering(const ParameterFile &file);
-  std::unique_ptr<Simulation> make_mlp_ordering(const ParameterFile &file, const CaseParameters &, Log &log);
-
-  // app/scenes/mlp_compression.cc, subsection "MLP compression".
-  void                        declare_mlp_compression_parameters(dealii::ParameterHandler &prm);
-  void                        check_mlp_compression(const ParameterFile &file);
-  std::unique_ptr<Simulation> make_mlp_compression(const ParameterFile &file, const CaseParameters &, Log &log);
-
-  // app/scenes/mlp_beams.cc, subsection "MLP beams".
-  void                        declare_mlp_beams_parameters(dealii::ParameterHandler &prm);
-  void                        check_mlp_beams(const ParameterFile &file);
-  std::unique_ptr<Simulation> make_mlp_beams(const ParameterFile &file, const CaseParameters &, Log &log);
+  // Each with the subsection "MLP" that every MLP scene reads (app/scenes/mlp_family.cc).
+  SceneHooks mlp_ordering_hooks();    ///< app/scenes/mlp_ordering.cc, subsection "MLP ordering"
+  SceneHooks mlp_compression_hooks(); ///< app/scenes/mlp_compression.cc, "MLP compression"
+  SceneHooks mlp_beams_hooks();       ///< app/scenes/mlp_beams.cc, "MLP beams"
 #endif
 } // namespace tribo::app

@@ -163,11 +163,11 @@ namespace tribo::app
       file.set("Shear cell/Initial state=" + p.shear.initial_state);
     // The scene's own entries are checked before anything is written.
     const SceneEntry &scene = scene_named(p.scene);
-    if (!scene.make)
+    if (!scene.hooks.make)
       throw InputError(o.case_file + ": Simulation/Scene = " + p.scene + " is not in this build (it needs " +
                        scene.build_option + "=ON)");
-    if (scene.check)
-      scene.check(file);
+    if (scene.hooks.check)
+      scene.hooks.check(file);
     if (o.check_only)
       {
         if (!o.quiet)
@@ -242,7 +242,7 @@ namespace tribo::app
     std::unique_ptr<Simulation> simulation;
     try
       {
-        simulation = scene.make(file, p, log);
+        simulation = scene.hooks.make(file, p, log);
       }
     catch (const InputError &e)
       {

@@ -16,20 +16,12 @@ namespace tribo::app
       return make_nscd_simulation(p, log);
     }
 
-    /// Gives the row of scene @p name (a module's scene, in this build) its subsections
-    /// @p declare, its @p check and its factory @p make.
-    void attach(std::vector<SceneEntry> &table, const std::string &name,
-                const std::vector<void (*)(dealii::ParameterHandler &)> &declare,
-                void (*check)(const ParameterFile &),
-                std::unique_ptr<Simulation> (*make)(const ParameterFile &, const CaseParameters &, Log &))
+    /// Gives the row of scene @p name (a module's scene, in this build) its @p hooks.
+    void attach(std::vector<SceneEntry> &table, const std::string &name, const SceneHooks &hooks)
     {
       for (SceneEntry &row : table)
         if (row.name == name)
-          {
-            row.declare = declare;
-            row.check   = check;
-            row.make    = make;
-          }
+          row.hooks = hooks;
     }
 
     /// The rows of every scene; those of the particle modules get their hooks only when
@@ -37,36 +29,30 @@ namespace tribo::app
     std::vector<SceneEntry> make_table()
     {
       std::vector<SceneEntry> table = {
-        {"collision", "two discs, Cao et al. 2011 Fig. 8", "", {}, nullptr, make_nscd},
+        {"collision", "two discs, Cao et al. 2011 Fig. 8", "", {{}, nullptr, make_nscd}},
         {"shear",
          "the third-body shear cell of Cao et al. 2011: a periodic layer of discs compacted, then sheared, "
          "between two rough walls",
-         "", {}, nullptr, make_nscd},
+         "", {{}, nullptr, make_nscd}},
         {"sph_slider", "the SPH slider on a substrate of Maveyraud et al. 1999, subsection SPH slider",
-         "TRIBO_WITH_SPH", {}, nullptr, nullptr},
-        {"sph_plate", "the SPH cantilever-plate check, subsection SPH plate", "TRIBO_WITH_SPH", {}, nullptr,
-         nullptr},
+         "TRIBO_WITH_SPH", {}},
+        {"sph_plate", "the SPH cantilever-plate check, subsection SPH plate", "TRIBO_WITH_SPH", {}},
         {"mlp_ordering",
          "movable lattice particles of Popov and Filippov 2006 ordering from random positions, "
          "subsections MLP and MLP ordering",
-         "TRIBO_WITH_MLP", {}, nullptr, nullptr},
+         "TRIBO_WITH_MLP", {}},
         {"mlp_compression", "an MLP slab compressed between two tractions, subsections MLP and MLP compression",
-         "TRIBO_WITH_MLP", {}, nullptr, nullptr},
+         "TRIBO_WITH_MLP", {}},
         {"mlp_beams", "two MLP beams in contact under a transverse traction, subsections MLP and MLP beams",
-         "TRIBO_WITH_MLP", {}, nullptr, nullptr}};
+         "TRIBO_WITH_MLP", {}}};
 #ifdef TRIBO_WITH_SPH_SCENES
-      attach(table, "sph_slider", {declare_sph_slider_parameters}, check_sph_slider, make_sph_slider);
-      attach(table, "sph_plate", {declare_sph_plate_parameters}, check_sph_plate, make_sph_plate);
+      attach(table, "sph_slider", sph_slider_hooks());
+      attach(table, "sph_plate", sph_plate_hooks());
 #endif
 #ifdef TRIBO_WITH_MLP_SCENES
-      attach(table, "mlp_ordering",
-             {declare_mlp_parameters, declare_mlp_ordering_parameters}, check_mlp_ordering,
-             make_mlp_ordering);
-      attach(table, "mlp_compression",
-             {declare_mlp_parameters, declare_mlp_compression_parameters}, check_mlp_compression,
-             make_mlp_compression);
-      attach(table, "mlp_beams",
-             {declare_mlp_parameters, declare_mlp_beams_parameters}, check_mlp_beams, make_mlp_beams);
+      attach(table, "mlp_ordering", mlp_ordering_hooks());
+      attach(table, "mlp_compression", mlp_compression_hooks());
+      attach(table, "mlp_beams", mlp_beams_hooks());
 #endif
       return table;
     }
@@ -101,7 +87,7 @@ namespace tribo::app
   {
     std::vector<void (*)(dealii::ParameterHandler &)> declared;
     for (const SceneEntry &s : scenes())
-      for (const auto declare : s.declare)
+      for (const auto declare : s.hooks.declare)
         if (std::find(declared.begin(), declared.end(), declare) == declared.end())
           {
             declare(prm);

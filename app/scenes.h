@@ -22,13 +22,9 @@ namespace tribo::app
 {
   struct CaseParameters; // app/case_parameters.h
 
-  struct SceneEntry
+  /// What a scene of this build gives the table: its subsections, its check, its factory.
+  struct SceneHooks
   {
-    std::string name;        ///< the value of Simulation/Scene
-    std::string description; ///< for Simulation/Scene's documentation
-    /// The CMake option that builds the scene's module, "" for the NSCD scenes (always
-    /// built).
-    std::string build_option;
     /// Declare the scene's subsections, each function one subsection (a subsection that
     /// scenes share, such as "MLP", is the same function in their rows and is declared
     /// once); empty: none beyond the NSCD subsections.
@@ -38,6 +34,16 @@ namespace tribo::app
     void (*check)(const ParameterFile &) = nullptr;
     /// Builds the scene (what it built goes to the log); nullptr: not in this build.
     std::unique_ptr<Simulation> (*make)(const ParameterFile &, const CaseParameters &, Log &) = nullptr;
+  };
+
+  struct SceneEntry
+  {
+    std::string name;        ///< the value of Simulation/Scene
+    std::string description; ///< for Simulation/Scene's documentation
+    /// The CMake option that builds the scene's module, "" for the NSCD scenes (always
+    /// built).
+    std::string build_option;
+    SceneHooks  hooks; ///< make == nullptr: the scene is not in this build
   };
 
   /// Every scene of the program, built or not, in the order of Simulation/Scene's

@@ -11,10 +11,6 @@
 
 namespace tribo::dem
 {
-  ActiveSetSolver::ActiveSetSolver(const SolverParameters &p)
-    : prm(p)
-  {}
-
   SolveReport ActiveSetSolver::solve(std::vector<Contact> &contacts, BodyState &state,
                                      const ContactLaw &law)
   {

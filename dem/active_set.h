@@ -24,26 +24,17 @@
 /// within the step), one numeric factorisation per iteration, sparse products in the
 /// line search. docs/laws.md gives the derivation and the measured behaviour.
 
-#include "dem/contact.h"
-#include "dem/contact_law.h"
-#include "dem/nlgs.h"
-
-#include <vector>
+#include "dem/frictionless_solver.h"
 
 namespace tribo::dem
 {
-  class ActiveSetSolver
+  class ActiveSetSolver : public FrictionlessSolver
   {
   public:
-    explicit ActiveSetSolver(const SolverParameters &p = {});
-    /// Solve the frictionless problem of @p contacts (warm-started from their r, whose
-    /// effect must already be in @p state), updating their impulses and @p state.
-    /// Throws RunError if @p law has friction. The report counts factorizations; if it
-    /// is not converged within SolverParameters::max_factorizations, the contacts and
-    /// @p state are left as they came (the caller then solves with NLGS).
-    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law);
-
-  private:
-    SolverParameters prm;
+    using FrictionlessSolver::FrictionlessSolver;
+    /// The report counts factorizations; if it is not converged within
+    /// SolverParameters::max_factorizations, the contacts and the state are left as they
+    /// came (the caller then solves with NLGS).
+    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law) override;
   };
 } // namespace tribo::dem

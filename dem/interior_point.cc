@@ -23,10 +23,6 @@ namespace tribo::dem
     }
   } // namespace
 
-  InteriorPointSolver::InteriorPointSolver(const SolverParameters &p)
-    : prm(p)
-  {}
-
   SolveReport InteriorPointSolver::solve(std::vector<Contact> &contacts, BodyState &state,
                                          const ContactLaw &law)
   {

@@ -29,24 +29,15 @@
 /// like 1 / mu), keeping its iterate (reported not converged). Cost per iteration: one numeric factorisation (the symbolic analysis once
 /// per step), two solves, two products with A'.
 
-#include "dem/contact.h"
-#include "dem/contact_law.h"
-#include "dem/nlgs.h"
-
-#include <vector>
+#include "dem/frictionless_solver.h"
 
 namespace tribo::dem
 {
-  class InteriorPointSolver
+  class InteriorPointSolver : public FrictionlessSolver
   {
   public:
-    explicit InteriorPointSolver(const SolverParameters &p = {});
-    /// Solve the frictionless problem of @p contacts (warm-started from their r, whose
-    /// effect must already be in @p state), updating their impulses and @p state.
-    /// Throws RunError if @p law has friction. The report counts factorizations.
-    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law);
-
-  private:
-    SolverParameters prm;
+    using FrictionlessSolver::FrictionlessSolver;
+    /// The report counts factorizations.
+    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law) override;
   };
 } // namespace tribo::dem

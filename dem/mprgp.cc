@@ -73,10 +73,6 @@ namespace tribo::dem
     };
   } // namespace
 
-  MprgpSolver::MprgpSolver(const SolverParameters &p)
-    : prm(p)
-  {}
-
   SolveReport MprgpSolver::solve(std::vector<Contact> &contacts, BodyState &state,
                                  const ContactLaw &law)
   {

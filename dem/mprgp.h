@@ -32,25 +32,15 @@
 /// about the cost of one NLGS sweep); it then keeps its last iterate, which satisfies
 /// x >= 0, and reports not converged.
 
-#include "dem/contact.h"
-#include "dem/contact_law.h"
-#include "dem/nlgs.h"
-
-#include <vector>
+#include "dem/frictionless_solver.h"
 
 namespace tribo::dem
 {
-  class MprgpSolver
+  class MprgpSolver : public FrictionlessSolver
   {
   public:
-    explicit MprgpSolver(const SolverParameters &p = {});
-    /// Solve the frictionless problem of @p contacts (warm-started from their r, whose
-    /// effect must already be in @p state), updating their impulses and @p state.
-    /// Throws RunError if @p law has friction. The report's iterations are the products
-    /// with the Delassus operator.
-    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law);
-
-  private:
-    SolverParameters prm;
+    using FrictionlessSolver::FrictionlessSolver;
+    /// The report's iterations are the products with the Delassus operator.
+    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law) override;
   };
 } // namespace tribo::dem

@@ -23,9 +23,7 @@ import math
 import os
 import sys
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from plotting import plt, save  # noqa: E402  (scripts/plotting.py)
 import numpy as np  # noqa: E402
 
 # Profile panels: (column, scale, axis label), in this order when present; a column drawn
@@ -35,13 +33,6 @@ PROFILE_PANELS = [("vx", 1.0, "vx (m/s)"), ("solid_fraction", 1.0, "solid fracti
                   ("sigma_xy", 1e6, "sigma_xy (MPa)")]
 PROFILE_OVERLAYS = {"sigma_xy": "sigma_yx"}
 PROFILE_NO_PANEL = {"layer", "y", "y_over_h", "n_samples", "n_discs", "sigma_yx"}
-
-
-def save(fig, path):
-    tmp = path + ".tmp.png"
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, path)
 
 
 def running_mean(v, n):

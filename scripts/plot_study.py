@@ -13,19 +13,8 @@ import csv
 import os
 import sys
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from plotting import plt, save  # noqa: E402  (scripts/plotting.py)
 import numpy as np  # noqa: E402
-
-
-
-
-def save(fig, path):
-    tmp = path + ".tmp.png"
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, path)
 
 
 def main(directory):

@@ -227,13 +227,8 @@ namespace tribo::app
     prm.leave_subsection();
   }
 
-  void check_mlp_beams(const ParameterFile &file)
+  SceneHooks mlp_beams_hooks()
   {
-    check_scene(file, make_scene);
-  }
-
-  std::unique_ptr<Simulation> make_mlp_beams(const ParameterFile &file, const CaseParameters &, Log &log)
-  {
-    return make_simulation(file, log, make_scene);
+    return mlp_scenes::hooks<make_scene>(declare_mlp_beams_parameters);
   }
 } // namespace tribo::app

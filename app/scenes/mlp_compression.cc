@@ -319,13 +319,8 @@ namespace tribo::app
     prm.leave_subsection();
   }
 
-  void check_mlp_compression(const ParameterFile &file)
+  SceneHooks mlp_compression_hooks()
   {
-    check_scene(file, make_scene);
-  }
-
-  std::unique_ptr<Simulation> make_mlp_compression(const ParameterFile &file, const CaseParameters &, Log &log)
-  {
-    return make_simulation(file, log, make_scene);
+    return mlp_scenes::hooks<make_scene>(declare_mlp_compression_parameters);
   }
 } // namespace tribo::app

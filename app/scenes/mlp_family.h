@@ -9,6 +9,7 @@
 /// energies J/m). x is the axis of the loads (left-right), y the transverse axis.
 
 #include "app/driver.h"
+#include "app/scenes.h"
 #include "core/parameter_file.h"
 #include "mlp/interaction.h"
 #include "mlp/langevin.h"
@@ -18,6 +19,12 @@
 #include <memory>
 #include <string>
 #include <utility>
+
+namespace tribo::app
+{
+  /// Declare the subsection "MLP" that every MLP scene reads (in each MLP scene's hooks).
+  void declare_mlp_parameters(dealii::ParameterHandler &prm);
+} // namespace tribo::app
 
 namespace tribo::app::mlp_scenes
 {
@@ -106,4 +113,17 @@ namespace tribo::app::mlp_scenes
   /// t = 0), snapshots every Snapshot interval steps, and a guard against a body flying
   /// apart (what it built goes to @p log).
   std::unique_ptr<Simulation> make_simulation(const ParameterFile &file, Log &log, SceneFactory make_scene);
+
+  /// The hooks of the scene table (app/scenes.h) for the MLP scene of @p make_scene whose
+  /// own subsection @p declare declares: the "MLP" subsection and it, check_scene() and
+  /// make_simulation().
+  template <SceneFactory make_scene>
+  SceneHooks hooks(void (*declare)(dealii::ParameterHandler &))
+  {
+    return {{declare_mlp_parameters, declare},
+            [](const ParameterFile &file) { check_scene(file, make_scene); },
+            [](const ParameterFile &file, const CaseParameters &, Log &log) {
+              return make_simulation(file, log, make_scene);
+            }};
+  }
 } // namespace tribo::app::mlp_scenes

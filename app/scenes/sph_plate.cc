@@ -215,15 +215,16 @@ namespace tribo::app
     prm.leave_subsection();
   }
 
-  void check_sph_plate(const ParameterFile &file)
+  SceneHooks sph_plate_hooks()
   {
-    EntryReader r(file);
-    read_plate(r);
-  }
-
-  std::unique_ptr<Simulation> make_sph_plate(const ParameterFile &file, const CaseParameters &, Log &log)
-  {
-    EntryReader r(file);
-    return make_plate(r, log);
+    return {{declare_sph_plate_parameters},
+            [](const ParameterFile &file) {
+              EntryReader r(file);
+              read_plate(r);
+            },
+            [](const ParameterFile &file, const CaseParameters &, Log &log) {
+              EntryReader r(file);
+              return make_plate(r, log);
+            }};
   }
 } // namespace tribo::app

@@ -729,16 +729,17 @@ namespace tribo::app
     prm.leave_subsection();
   }
 
-  void check_sph_slider(const ParameterFile &file)
+  SceneHooks sph_slider_hooks()
   {
-    EntryReader r(file);
-    read_slider(r);
-  }
-
-  std::unique_ptr<Simulation> make_sph_slider(const ParameterFile &file, const CaseParameters &, Log &log)
-  {
-    EntryReader              r(file);
-    const SliderParameters p = read_slider(r);
-    return p.dim == 2 ? make_slider<2>(r, p, log) : make_slider<3>(r, p, log);
+    return {{declare_sph_slider_parameters},
+            [](const ParameterFile &file) {
+              EntryReader r(file);
+              read_slider(r);
+            },
+            [](const ParameterFile &file, const CaseParameters &, Log &log) {
+              EntryReader              r(file);
+              const SliderParameters p = read_slider(r);
+              return p.dim == 2 ? make_slider<2>(r, p, log) : make_slider<3>(r, p, log);
+            }};
   }
 } // namespace tribo::app

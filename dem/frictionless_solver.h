@@ -1,0 +1,27 @@
+#pragma once
+/// @file The interface of the global methods on the frictionless contact problem
+/// (dem/frictionless_problem.h): the active set (dem/active_set.h), MPRGP (dem/mprgp.h)
+/// and the interior point (dem/interior_point.h), chosen by SolverParameters::method.
+
+#include "dem/contact.h"
+#include "dem/contact_law.h"
+#include "dem/nlgs.h"
+
+#include <vector>
+
+namespace tribo::dem
+{
+  class FrictionlessSolver
+  {
+  public:
+    explicit FrictionlessSolver(const SolverParameters &p = {}) : prm(p) {}
+    virtual ~FrictionlessSolver() = default;
+    /// Solve the frictionless problem of @p contacts (warm-started from their r, whose
+    /// effect must already be in @p state), updating their impulses and @p state.
+    /// Throws RunError if @p law has friction. What the report counts: each method says.
+    virtual SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law) = 0;
+
+  protected:
+    SolverParameters prm;
+  };
+} // namespace tribo::dem
