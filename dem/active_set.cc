@@ -11,14 +11,10 @@
 
 namespace tribo::dem
 {
-  SolveReport ActiveSetSolver::solve(std::vector<Contact> &contacts, BodyState &state,
-                                     const ContactLaw &law)
+  SolveReport ActiveSetSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
   {
     SolveReport report;
     const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());
-    if (n == 0)
-      return report;
-    require_frictionless(law, "active-set");
 
     FrictionlessProblem   lcp(contacts, state);
     const Eigen::SparseMatrix<double> &A = lcp.A;

@@ -35,6 +35,9 @@ namespace tribo::dem
     /// The report counts factorizations; if it is not converged within
     /// SolverParameters::max_factorizations, the contacts and the state are left as they
     /// came (the caller then solves with NLGS).
-    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law) override;
+    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
+
+  private:
+    const char *name() const override { return "active-set"; }
   };
 } // namespace tribo::dem

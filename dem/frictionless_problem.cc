@@ -1,4 +1,5 @@
 #include "dem/frictionless_problem.h"
+#include "dem/frictionless_solver.h"
 
 #include "core/errors.h"
 #include "dem/delassus.h"
@@ -80,6 +81,14 @@ namespace tribo::dem
     p.b = b.cwiseProduct(p.inv_root);
     p.y = x.cwiseQuotient(p.inv_root);
     return p;
+  }
+
+  SolveReport FrictionlessSolver::solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law)
+  {
+    if (contacts.empty())
+      return {};
+    require_frictionless(law, name());
+    return solve_problem(contacts, state);
   }
 
   void require_frictionless(const ContactLaw &law, const std::string &method)

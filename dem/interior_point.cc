@@ -23,13 +23,9 @@ namespace tribo::dem
     }
   } // namespace
 
-  SolveReport InteriorPointSolver::solve(std::vector<Contact> &contacts, BodyState &state,
-                                         const ContactLaw &law)
+  SolveReport InteriorPointSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
   {
     SolveReport report;
-    if (contacts.empty())
-      return report;
-    require_frictionless(law, "interior-point");
     const FrictionlessProblem lcp(contacts, state, true);
     const Eigen::Index        n = lcp.size();
     // The scaled problem (dem/mprgp.h).

@@ -38,6 +38,9 @@ namespace tribo::dem
   public:
     using FrictionlessSolver::FrictionlessSolver;
     /// The report counts factorizations.
-    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law) override;
+    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
+
+  private:
+    const char *name() const override { return "interior-point"; }
   };
 } // namespace tribo::dem

@@ -71,15 +71,52 @@ namespace tribo::dem
         phi_Ap += o.phi_Ap;
       }
     };
+    /// U' (n x k), nonzero only in the rows of the walls' contacts, kept by rows so that
+    /// its part of a product costs O(wall contacts), not O(n k).
+    class LowRankRows
+    {
+    public:
+      explicit LowRankRows(const Eigen::MatrixXd &U) : start(U.rows() + 1, 0)
+      {
+        for (Index j = 0; j < U.rows(); ++j)
+          {
+            for (Index k = 0; k < U.cols(); ++k)
+              if (U(j, k) != 0)
+                {
+                  column.push_back(k);
+                  value.push_back(U(j, k));
+                }
+            start[j + 1] = static_cast<Index>(value.size());
+            if (start[j + 1] > start[j])
+              rows.push_back(j);
+          }
+      }
+      /// @p t = U'^T @p v.
+      void transpose_times(const Eigen::VectorXd &v, Eigen::VectorXd &t) const
+      {
+        t.setZero();
+        for (const Index j : rows)
+          for (Index q = start[j]; q < start[j + 1]; ++q)
+            t[column[q]] += value[q] * v[j];
+      }
+      /// (U' @p t)_j.
+      double row_times(Index j, const Eigen::VectorXd &t) const
+      {
+        double sum = 0;
+        for (Index q = start[j]; q < start[j + 1]; ++q)
+          sum += value[q] * t[column[q]];
+        return sum;
+      }
+
+    private:
+      std::vector<Index>  start, rows, column;
+      std::vector<double> value;
+    };
   } // namespace
 
-  SolveReport MprgpSolver::solve(std::vector<Contact> &contacts, BodyState &state,
-                                 const ContactLaw &law)
+  SolveReport MprgpSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
   {
     SolveReport report;
-    if (contacts.empty())
-      return report;
-    require_frictionless(law, "MPRGP");
     // The walls (bodies with many contacts) as low-rank terms: A' + U'U'^T, so that a
     // product costs O(nnz(A') + n k) instead of the walls' dense blocks.
     const FrictionlessProblem lcp(contacts, state, true);
@@ -88,7 +125,6 @@ namespace tribo::dem
     FrictionlessProblem::Scaled       scaled   = lcp.scaled();
     const Eigen::VectorXd            &inv_root = scaled.inv_root;
     const Eigen::SparseMatrix<double> &A        = scaled.A;
-    const Eigen::MatrixXd            &U        = scaled.U;
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
     double norm_bound        = 0; // ||A'|| <= max absolute column sum
@@ -99,46 +135,24 @@ namespace tribo::dem
           sum += std::abs(a.value());
         norm_bound = std::max(norm_bound, sum);
       }
-    norm_bound += U.squaredNorm(); // ||U'U'^T|| <= ||U'||_F^2
+    norm_bound += scaled.U.squaredNorm(); // ||U'U'^T|| <= ||U'||_F^2
     const double          alpha     = 1.9 / norm_bound;
     const double          gamma2    = 1.0; // Gamma^2
     const unsigned int    threads   = prm.threads;
 
     // Column j of the symmetric A' is its row j: ((A' + U'U'^T) v)_j from column j alone,
-    // once Ut_v = U'^T v is known (set_low_rank_product). U' is nonzero only in the rows
-    // of the walls' contacts: kept as rows (u_start, u_column, u_value) so that the
-    // low-rank part costs O(wall contacts) per product.
-    const int          *start = A.outerIndexPtr();
-    const int          *row   = A.innerIndexPtr();
-    const double       *value = A.valuePtr();
-    std::vector<Index>  u_start(n + 1, 0), u_rows, u_column;
-    std::vector<double> u_value;
-    for (Index j = 0; j < n; ++j)
-      {
-        for (Index k = 0; k < U.cols(); ++k)
-          if (U(j, k) != 0)
-            {
-              u_column.push_back(k);
-              u_value.push_back(U(j, k));
-            }
-        u_start[j + 1] = static_cast<Index>(u_value.size());
-        if (u_start[j + 1] > u_start[j])
-          u_rows.push_back(j);
-      }
-    Eigen::VectorXd Ut_v(U.cols());
-    auto            set_low_rank_product = [&](const Eigen::VectorXd &v) {
-      Ut_v.setZero();
-      for (const Index j : u_rows)
-        for (Index q = u_start[j]; q < u_start[j + 1]; ++q)
-          Ut_v[u_column[q]] += u_value[q] * v[j];
-    };
+    // once Ut_v = U'^T v is known (set_low_rank_product).
+    const int         *start = A.outerIndexPtr();
+    const int         *row   = A.innerIndexPtr();
+    const double      *value = A.valuePtr();
+    const LowRankRows  U(scaled.U);
+    Eigen::VectorXd    Ut_v(scaled.U.cols());
+    auto               set_low_rank_product = [&](const Eigen::VectorXd &v) { U.transpose_times(v, Ut_v); };
     auto times = [&](const Eigen::VectorXd &v, Index j) {
       double sum = 0;
       for (int k = start[j]; k < start[j + 1]; ++k)
         sum += value[k] * v[row[k]];
-      for (Index q = u_start[j]; q < u_start[j + 1]; ++q)
-        sum += u_value[q] * Ut_v[u_column[q]];
-      return sum;
+      return sum + U.row_times(j, Ut_v);
     };
 
     Eigen::VectorXd g(n), p(n), Ap(n), phi(n), beta(n);

@@ -41,6 +41,9 @@ namespace tribo::dem
   public:
     using FrictionlessSolver::FrictionlessSolver;
     /// The report's iterations are the products with the Delassus operator.
-    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law) override;
+    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
+
+  private:
+    const char *name() const override { return "MPRGP"; }
   };
 } // namespace tribo::dem

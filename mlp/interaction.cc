@@ -63,22 +63,18 @@ namespace tribo::mlp
 
   double PairPotential::energy(double r) const
   {
-    double       dsdr;
+    double       dsdr, e;
     const double S = switch_value(r, dsdr);
-    if (S == 0)
-      return 0;
-    const double e = std::exp(-a * (r - r0));
-    return D * ((1 - e) * (1 - e) - 1) * S;
+    return S == 0 ? 0 : morse_well(r, e) * S;
   }
 
   double PairPotential::derivative(double r) const
   {
-    double       dsdr;
+    double       dsdr, e;
     const double S = switch_value(r, dsdr);
     if (S == 0)
       return 0;
-    const double e = std::exp(-a * (r - r0));
-    const double u = D * ((1 - e) * (1 - e) - 1);
+    const double u = morse_well(r, e);
     return 2 * D * a * (1 - e) * e * S + u * dsdr;
   }
 

@@ -15,6 +15,7 @@
 #include "mlp/neighbour_list.h"
 #include "mlp/particles.h"
 
+#include <cmath>
 #include <Eigen/Core>
 
 #include <vector>
@@ -69,6 +70,13 @@ namespace tribo::mlp
     double derivative(double r) const;
     /// Switch S(r) and its derivative dS/dr (1/m) in @p dsdr.
     double switch_value(double r, double &dsdr) const;
+    /// The unswitched Morse well U_M(r) = D ((1 - e)^2 - 1), J/m, with
+    /// e = exp(-a (r - r0)) in @p e.
+    double morse_well(double r, double &e) const
+    {
+      e = std::exp(-a * (r - r0));
+      return D * ((1 - e) * (1 - e) - 1);
+    }
     /// Well depth D, J/m.
     double depth() const { return D; }
     /// Cutoff radius r_c, m.

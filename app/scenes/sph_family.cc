@@ -63,6 +63,26 @@ namespace tribo::app::sph_scenes
     return name == "basalt" ? sph::Material::basalt() : sph::Material::granite();
   }
 
+  void declare_integration_entries(dealii::ParameterHandler &prm)
+  {
+    using dealii::Patterns::Double;
+    prm.declare_entry("Artificial viscosity alpha", "1", Double(), "Monaghan viscosity alpha, >= 0.");
+    prm.declare_entry("Artificial viscosity beta", "0.1", Double(), "Monaghan viscosity beta, >= 0.");
+    prm.declare_entry("CFL number", "0.3", Double(), "C in dt = C h/(c (1 + 1.2 alpha) + beta max mu), in (0, 1].");
+    prm.declare_entry("Step floor", "1e-12", Double(),
+                      "Smallest allowed step, s (> 0): a smaller one ends the run with status failed.");
+  }
+
+  sph::SolverParameters read_integration(EntryReader &r, const std::string &section)
+  {
+    sph::SolverParameters s;
+    s.alpha   = r.number(section + "Artificial viscosity alpha", non_negative, "alpha >= 0");
+    s.beta    = r.number(section + "Artificial viscosity beta", non_negative, "beta >= 0");
+    s.courant = r.number(section + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
+    s.dt_min  = r.number(section + "Step floor", positive, "a positive step floor in s");
+    return s;
+  }
+
   namespace
   {
     /// VTU text of the particles: one vertex per particle with velocity (m/s), boundary

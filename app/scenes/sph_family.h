@@ -10,6 +10,7 @@
 #include "app/driver.h"
 #include "core/parameter_file.h"
 #include "sph/eos.h"
+#include "sph/solver.h"
 
 #include <array>
 #include <functional>
@@ -60,6 +61,15 @@ namespace tribo::app::sph_scenes
 
   /// The material named granite or basalt (pattern-checked).
   sph::Material material_named(const std::string &name);
+
+  /// Declare, in the current subsection, the entries of the explicit integration that
+  /// every SPH scene has: Artificial viscosity alpha and beta (Monaghan), CFL number C
+  /// (dt = C h / (c (1 + 1.2 alpha) + beta max mu)) and Step floor (s).
+  void declare_integration_entries(dealii::ParameterHandler &prm);
+
+  /// Read those entries of subsection @p section ("SPH plate/") into a solver's
+  /// parameters (the others at their defaults); InputError naming the entry.
+  sph::SolverParameters read_integration(EntryReader &r, const std::string &section);
 
   /// What an SPH scene adds to the family's Simulation, its part of the time loop: its
   /// step limit, its per-step bookkeeping, its rows and its summary.

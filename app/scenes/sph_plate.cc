@@ -28,7 +28,8 @@ namespace tribo::app
     {
       sph::Material material;
       double        length = 0, thickness = 0, spacing = 0, smoothing_ratio = 1.2, tip_velocity = 0;
-      double        alpha = 1, beta = 0.1, courant = 0.3, dt_min = 0, end_time = 0;
+      sph::SolverParameters integration; ///< viscosity, CFL number, step floor
+      double        end_time = 0;
       double        statistics_interval = 0, field_interval = 0;
     };
 
@@ -44,10 +45,7 @@ namespace tribo::app
       p.smoothing_ratio = r.number(s + "Smoothing length ratio", [](double v) { return v >= 1 && v <= 2; },
                                    "a ratio h/a in [1, 2]");
       p.tip_velocity = r.number(s + "Tip velocity", positive, "a positive velocity in m/s");
-      p.alpha   = r.number(s + "Artificial viscosity alpha", non_negative, "alpha >= 0");
-      p.beta    = r.number(s + "Artificial viscosity beta", non_negative, "beta >= 0");
-      p.courant = r.number(s + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
-      p.dt_min  = r.number(s + "Step floor", positive, "a positive step floor in s");
+      p.integration  = read_integration(r, s);
       p.end_time = r.number("Simulation/End time", positive, "a positive end time in s");
       p.statistics_interval = r.number(s + "Statistics interval", positive, "a positive interval in s");
       p.field_interval = r.number(s + "Field interval", non_negative, "an interval >= 0 in s");
@@ -185,14 +183,9 @@ namespace tribo::app
     std::unique_ptr<Simulation> make_plate(EntryReader &r, Log &log)
     {
       const PlateParameters p = read_plate(r);
-      sph::SolverParameters s;
-      s.alpha   = p.alpha;
-      s.beta    = p.beta;
-      s.courant = p.courant;
-      s.dt_min  = p.dt_min;
       return make_simulation<2>(
         LoopSettings{"sph_plate", p.end_time, p.statistics_interval, p.field_interval},
-        std::make_unique<sph::Solver<2>>(std::vector<sph::Material>{p.material}, s),
+        std::make_unique<sph::Solver<2>>(std::vector<sph::Material>{p.material}, p.integration),
         [&](sph::Solver<2> &solver) { return std::make_unique<Plate>(p, solver, log); });
     }
   } // namespace
@@ -206,10 +199,7 @@ namespace tribo::app
     prm.declare_entry("Particle spacing", "3.333333333333333e-3", Double(), "Square-lattice spacing a, m (> 0).");
     prm.declare_entry("Smoothing length ratio", "1.2", Double(), "h/a, in [1, 2].");
     prm.declare_entry("Tip velocity", "0.05", Double(), "Initial tip velocity V of the first mode, m/s (> 0).");
-    prm.declare_entry("Artificial viscosity alpha", "1", Double(), "Monaghan viscosity alpha, >= 0.");
-    prm.declare_entry("Artificial viscosity beta", "0.1", Double(), "Monaghan viscosity beta, >= 0.");
-    prm.declare_entry("CFL number", "0.3", Double(), "CFL number, in (0, 1].");
-    prm.declare_entry("Step floor", "1e-12", Double(), "Smallest allowed step, s (> 0).");
+    declare_integration_entries(prm);
     prm.declare_entry("Statistics interval", "2e-5", Double(), "Simulated time between rows, s (> 0).");
     prm.declare_entry("Field interval", "0", Double(), "Simulated time between VTU snapshots, s (>= 0).");
     prm.leave_subsection();

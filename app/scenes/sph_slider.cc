@@ -61,7 +61,7 @@ namespace tribo::app
       double                gamma = 0, settling_gamma = 0;
       bool                  damping_to_sliding_velocity = true;
       unsigned int          driven_layers = 1;
-      double                alpha = 1, beta = 0.1, courant = 0.3, dt_min = 0;
+      sph::SolverParameters integration; ///< viscosity, CFL number, step floor
       double                stiffness_factor = 1, range_ratio = 1;
       bool                  rest_on_tips = false;
       Surface               surface = Surface::periodic;
@@ -95,10 +95,7 @@ namespace tribo::app
       p.settling_gamma = r.number(s + "Settling gamma", non_negative, "a damping rate >= 0 in 1/s");
       p.damping_to_sliding_velocity = r.text(s + "Damping reference") == "sliding velocity";
       p.driven_layers = static_cast<unsigned int>(r.integer(s + "Driven layers", 1, "an integer >= 1"));
-      p.alpha   = r.number(s + "Artificial viscosity alpha", non_negative, "alpha >= 0");
-      p.beta    = r.number(s + "Artificial viscosity beta", non_negative, "beta >= 0");
-      p.courant = r.number(s + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
-      p.dt_min  = r.number(s + "Step floor", positive, "a positive step floor in s");
+      p.integration = read_integration(r, s);
       p.stiffness_factor = r.number(s + "Boundary stiffness factor", positive, "a positive factor");
       p.range_ratio = r.number(s + "Boundary range ratio", [](double v) { return v > 0 && v < 2; },
                                "a ratio d/a in (0, 2)");
@@ -611,11 +608,7 @@ namespace tribo::app
     template <int dim>
     sph::SolverParameters slider_solver(const SliderParameters &p, double substrate_period)
     {
-      sph::SolverParameters s;
-      s.alpha    = p.alpha;
-      s.beta     = p.beta;
-      s.courant  = p.courant;
-      s.dt_min   = p.dt_min;
+      sph::SolverParameters s = p.integration;
       s.period   = p.periodic ? substrate_period : 0;
       const double E = young_and_poisson(p.material).first;
       s.boundary = sph::BoundaryForce::spring(p.stiffness_factor * E * std::pow(p.spacing, dim - 2),
@@ -680,11 +673,7 @@ namespace tribo::app
                       "Number of top layers of the block whose horizontal velocity is imposed (vertical free), >= 1. "
                       "The paper drives the first and sometimes the second layer; the block follows either "
                       "(2D quick case: mu 0.0025 with one, 0.0012 with two; docs/validation.md).");
-    prm.declare_entry("Artificial viscosity alpha", "1", Double(), "Monaghan viscosity alpha, >= 0.");
-    prm.declare_entry("Artificial viscosity beta", "0.1", Double(), "Monaghan viscosity beta, >= 0.");
-    prm.declare_entry("CFL number", "0.3", Double(), "C in dt = C h/(c (1 + 1.2 alpha) + beta max mu), in (0, 1].");
-    prm.declare_entry("Step floor", "1e-12", Double(),
-                      "Smallest allowed step, s (> 0): a smaller one ends the run with status failed.");
+    declare_integration_entries(prm);
     prm.declare_entry("Boundary stiffness factor", "1",  Double(),
                       "k in the spring law f1 between the bodies, K = k E a^(dim-2) (N/m in 3D, N/m per m "
                       "of depth in 2D; the paper's K ~ E h estimate), > 0.");
