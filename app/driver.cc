@@ -41,11 +41,11 @@ namespace tribo::app
         std::vector<double> values;
         for (std::size_t c = 0; c < row.columns().size(); ++c)
           {
-            if (c >= table.columns().size() || row.columns()[c].first != table.columns()[c])
+            if (row.columns()[c].first != table.columns()[c])
               throw RunError("statistics row: column " + std::to_string(c + 1) + " is '" +
                              row.columns()[c].first + "' where the first row (or the checkpoint "
-                             "resumed) has '" + (c < table.columns().size() ? table.columns()[c] : "") +
-                             "' (a checkpoint of another version of tribo?)");
+                             "resumed) has '" + table.columns()[c] + "' (a checkpoint of another "
+                             "version of tribo?)");
             values.push_back(row.columns()[c].second);
           }
         table.add_row(values);
