@@ -72,7 +72,6 @@ namespace tribo::app
         b.resolution = sc.mean_diameter * (1 - sc.diameter_spread);
       b.theta              = p.theta;
       b.time_step          = p.time_step;
-      b.time_step_entry    = "Simulation/Time step";
       b.pressure           = sc.pressure;
       b.pressure_ramp_time = sc.ramp_time;
       if (sc.shear_start == 0)

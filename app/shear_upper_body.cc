@@ -91,6 +91,7 @@ namespace tribo::app
         return {body->write_fields(dir, index)};
       }
       std::string describe() const override { return body->describe(); }
+      void        summarize(JsonObject &j) const override { body->summarize(j); }
       void        save(CheckpointOut &ar) const override { body->save(ar); }
       void        load(CheckpointIn &ar) override { body->load(ar); }
 

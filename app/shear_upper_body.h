@@ -61,6 +61,8 @@ namespace tribo::app
     virtual std::vector<std::string> write_fields(const std::string &, unsigned int) const { return {}; }
     /// A line for the log ("" for none).
     virtual std::string describe() const { return ""; }
+    /// Its own figures for summary.json.
+    virtual void summarize(JsonObject &) const {}
     virtual void save(CheckpointOut &) const {}
     virtual void load(CheckpointIn &) {}
   };

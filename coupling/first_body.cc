@@ -174,22 +174,11 @@ namespace tribo::coupling
                            "': expected at most " + std::to_string(interior - 2) + ", the body's " +
                            std::to_string(interior) + " interior unknowns less 2");
       }
-    if (p.model != "sph" && p.model != "mlp")
-      return;
     if (p.model == "mlp" && p.poisson_ratio > 0.25 + 1e-12)
       throw InputError("entry '" + p.section.entry("Upper body Poisson ratio") + "' = '" + to_text(p.poisson_ratio) +
                        "': an mlp upper body needs nu <= 0.25 (its plane-strain 2D ratio nu/(1 - nu) must "
                        "be <= 1/3: return forces can only lower it); use 0.25 or less, or Upper body "
                        "model = fem or sph");
-    const double s = p.length / chain_nodes(p), c = p_wave_speed(p);
-    const double h_max = particle_coupling_courant * s / c;
-    if (p.time_step > h_max * (1 + 1e-12))
-      throw InputError("entry '" + p.time_step_entry + "' = '" + to_text(p.time_step) + "': an " + p.model +
-                       " upper body is kicked by the contacts once per step, stable only for c_p h / s <= " +
-                       to_text(particle_coupling_courant) + "; with c_p = " + to_text(c) +
-                       " m/s and particle spacing s = " + to_text(s) + " m that is h <= " + to_text(h_max) +
-                       " s: use " + p.time_step_entry + " = " + to_text(h_max) + " or less, or a larger " +
-                       p.section.entry("Upper body cell size"));
   }
 
   std::string first_body_snapshot_name(unsigned int index)

@@ -10,8 +10,9 @@
 ///   vibration modes and a load mode (fem::ElasticBodyParameters::reduced);
 /// - sph: a solid SPH block (sph/) on a square lattice, linear equation of state;
 /// - mlp: a movable-lattice-particle block (mlp/) on a hexagonal lattice.
-/// The particle models are explicit: their bottom row of particles is the contact chain
-/// and they sub-cycle inside a contact step (coupling/particle_first_body.h).
+/// The particle models sub-cycle their explicit integrators inside a contact step; their
+/// bottom row of particles is the contact chain, its compliance over the step measured
+/// from the body's own dynamics (coupling/particle_first_body.h).
 ///
 /// All share: period L along x, thickness H, bottom face (the chain) at y0, top face
 /// held in x and loaded by the pressure P(t) = P min(1, t / ramp) (compressive), and a
@@ -20,6 +21,7 @@
 /// Units per unit depth: m, kg/m, N/m, J/m, W/m.
 
 #include "core/checkpoint.h"
+#include "core/output.h"
 #include "core/parameter_section.h"
 #include "dem/boundary.h"
 
@@ -71,9 +73,6 @@ namespace tribo::coupling
     /// The case subsection the body's entries were read from: messages name them
     /// through it.
     ParameterSection section;
-    /// The case entry that sets time_step, named when the step is too long for the
-    /// coupling (check_first_body()).
-    std::string time_step_entry = "time step";
 
     /// Declare the body's entries in the current subsection of @p prm (the caller enters
     /// and leaves it).
@@ -114,20 +113,15 @@ namespace tribo::coupling
     virtual std::string write_fields(const std::string &dir, unsigned int index) const = 0;
     /// One line for the log: model, resolution, counts.
     virtual std::string describe() const = 0;
+    /// The coupling's own figures for summary.json (none by default).
+    virtual void summarize(JsonObject &) const {}
     virtual void save(CheckpointOut &ar) const = 0;
     virtual void load(CheckpointIn &ar) = 0;
   };
 
-  /// Largest c_p h / s (P-wave speed times contact step over particle spacing) at which
-  /// an sph or mlp body is coupled: its chain particles are kicked once per contact step,
-  /// which is stable only if the step resolves their own vibration (measured on the
-  /// 120-disc cell, mlp: worst overlap 0.2 r at 0.78, 0.7 r at 1.5, grains driven
-  /// through the chain at 3.9; docs/first_bodies.md).
-  constexpr double particle_coupling_courant = 1.0;
-
   /// Throws InputError, naming the case entry and a value that would work, if @p p
-  /// cannot run: for sph and mlp a contact step above the coupling limit
-  /// (particle_coupling_courant), for mlp a Poisson ratio above 1/4.
+  /// cannot run: for mlp a Poisson ratio above 1/4, for reduced more modes than the
+  /// body has interior unknowns.
   void check_first_body(const FirstBodyParameters &p);
 
   /// The body of model p.model (check_first_body() first). Throws InputError for a model this build left out

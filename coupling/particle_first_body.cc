@@ -4,10 +4,12 @@
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/vector.hpp>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <sstream>
 
 namespace tribo::coupling
@@ -22,22 +24,14 @@ namespace tribo::coupling
     reference_x.resize(n);
     start.resize(n);
     free.assign(n, dem::Vec2::Zero());
-    G = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+    begin_velocity.assign(n, dem::Vec2::Zero());
+    end_velocity.assign(n, dem::Vec2::Zero());
     for (unsigned int i = 0; i < n; ++i)
       {
         reference_x[i] = position(chain[i]).x();
         start[i]       = position(chain[i]);
       }
-    build_compliance(prm.time_step);
-  }
-
-  void ParticleFirstBody::build_compliance(double h)
-  {
-    const unsigned int n = chain.size();
-    G                    = Eigen::MatrixXd::Zero(2 * n, 2 * n);
-    for (unsigned int i = 0; i < n; ++i)
-      G(2 * i, 2 * i) = G(2 * i + 1, 2 * i + 1) = 1 / mass(chain[i]);
-    compliance_h = h;
+    G = Eigen::MatrixXd::Zero(2 * n, 2 * n);
   }
 
   dem::Vec2 ParticleFirstBody::unwrapped(unsigned int i) const
@@ -48,66 +42,170 @@ namespace tribo::coupling
     return x;
   }
 
+  Eigen::VectorXd ParticleFirstBody::chain_displacement() const
+  {
+    Eigen::VectorXd d(2 * chain.size());
+    for (unsigned int i = 0; i < chain.size(); ++i)
+      d.segment<2>(2 * i) = unwrapped(i) - start[i];
+    return d;
+  }
+
+  double ParticleFirstBody::top_load(double h) const
+  {
+    const double t_mid = time + 0.5 * h;
+    const double ramp  = prm.pressure_ramp_time > 0 ? std::min(1.0, t_mid / prm.pressure_ramp_time) : 1.0;
+    return -ramp * prm.pressure * prm.length / top.size();
+  }
+
+  std::string ParticleFirstBody::snapshot() const
+  {
+    std::ostringstream os;
+    {
+      CheckpointOut ar(os, boost::archive::no_header);
+      save_engine(ar);
+    }
+    return os.str();
+  }
+
+  void ParticleFirstBody::restore(const std::string &state)
+  {
+    std::istringstream is(state);
+    CheckpointIn       ar(is, boost::archive::no_header);
+    load_engine(ar);
+  }
+
+  void ParticleFirstBody::build_compliance(double h, double load)
+  {
+    // Column 2j + c: advance from S_0 with the force eps e_c / h on chain particle j: eps =
+    // P s h, the impulse a chain particle carries in a step under the load (a secant at
+    // the contacts' amplitude); unloaded, eps moves a free particle by compliance_probe
+    // spacings (eps h / (2 m)).
+    const unsigned int n       = chain.size();
+    const double       spacing = prm.length / n;
+    Eigen::MatrixXd    D(2 * n, 2 * n);
+    std::vector<dem::Vec2> force(n, dem::Vec2::Zero());
+    for (unsigned int j = 0; j < n; ++j)
+      for (int c = 0; c < 2; ++c)
+        {
+          const double eps = prm.pressure > 0 ? prm.pressure * spacing * h
+                                              : 2 * mass(chain[j]) * compliance_probe * spacing / h;
+          restore(start_state);
+          force[j][c] = eps / h;
+          advance(h, load, force);
+          D.col(2 * j + c) = (chain_displacement() - free_displacement) / eps;
+          force[j][c] = 0;
+        }
+    engine_free = false;
+    asymmetry   = (D - D.transpose()).norm() / D.norm();
+    // sym(D) is positive semi-definite for a linear conservative body (file comment);
+    // round-off and the nonlinear terms may leave tiny negative eigenvalues: clip them.
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (D + D.transpose()));
+    const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
+    G            = eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose() / (prm.theta * h);
+    compliance_h  = h;
+    stale         = false;
+    built_at_step = steps;
+    ++builds;
+  }
+
   void ParticleFirstBody::predict(double h)
   {
     const unsigned int n = chain.size();
-    if (h != compliance_h)
-      build_compliance(h);
     for (unsigned int i = 0; i < n; ++i)
-      start[i] = unwrapped(i);
+      {
+        start[i]          = unwrapped(i);
+        begin_velocity[i] = velocity(chain[i]);
+      }
     top_start_y.resize(top.size());
     for (std::size_t q = 0; q < top.size(); ++q)
       top_start_y[q] = position(top[q]).y();
-    const double dissipated_before = total_dissipation();
+    dissipation_at_start = total_dissipation();
+    start_state          = snapshot();
+    step_h               = h;
+    step_load            = top_load(h);
 
-    // The top load at mid-step, shared equally by the top particles (compressive).
-    const double t_mid = time + 0.5 * h;
-    const double ramp  = prm.pressure_ramp_time > 0 ? std::min(1.0, t_mid / prm.pressure_ramp_time) : 1.0;
-    const double load  = -ramp * prm.pressure * prm.length / top.size();
-    substeps           = advance(h, load);
-
-    load_work = 0;
-    for (std::size_t q = 0; q < top.size(); ++q)
-      load_work += load * (position(top[q]).y() - top_start_y[q]);
-    dissipated = total_dissipation() - dissipated_before;
+    substeps          = advance(h, step_load, std::vector<dem::Vec2>(n, dem::Vec2::Zero()));
+    free_displacement = chain_displacement();
+    engine_free       = true;
+    const double th   = prm.theta;
     for (unsigned int i = 0; i < n; ++i)
-      free[i] = velocity(chain[i]);
-    step_h = h;
+      free[i] = (free_displacement.segment<2>(2 * i) / h - (1 - th) * begin_velocity[i]) / th;
+    if (stale || h != compliance_h)
+      build_compliance(h, step_load);
+    in_step = true;
   }
 
   void ParticleFirstBody::finalize(const std::vector<dem::Vec2> &impulses)
   {
-    if (!impulses.empty() && impulses.size() != chain.size())
+    const unsigned int n = chain.size();
+    if (!impulses.empty() && impulses.size() != n)
       throw RunError("particle first body: " + std::to_string(impulses.size()) + " node impulses for " +
-                     std::to_string(chain.size()) + " chain particles");
-    const double stored_before = stored_energy();
-    std::vector<dem::Vec2> dv(impulses.size()), dx(impulses.size());
+                     std::to_string(n) + " chain particles");
+    const double h = step_h, th = prm.theta;
+    Eigen::VectorXd R = Eigen::VectorXd::Zero(2 * n);
     for (std::size_t i = 0; i < impulses.size(); ++i)
+      R.segment<2>(2 * i) = impulses[i];
+    if (R.squaredNorm() > 0 || !engine_free)
       {
-        dv[i] = G(2 * i, 2 * i) * impulses[i];
-        dx[i] = prm.theta * step_h * dv[i];
+        restore(start_state);
+        std::vector<dem::Vec2> force(n);
+        for (unsigned int i = 0; i < n; ++i)
+          force[i] = R.segment<2>(2 * i) / h;
+        substeps = advance(h, step_load, force);
       }
-    if (!impulses.empty())
-      kick(chain, dv, dx);
-    correction_work = impulses.empty() ? 0.0 : stored_energy() - stored_before;
-    time += step_h;
-    for (unsigned int i = 0; i < chain.size(); ++i)
+    engine_free = false;
+    in_step     = false;
+
+    // The books of the real step.
+    load_work = 0;
+    for (std::size_t q = 0; q < top.size(); ++q)
+      load_work += step_load * (position(top[q]).y() - top_start_y[q]);
+    dissipated                = total_dissipation() - dissipation_at_start;
+    const Eigen::VectorXd d   = chain_displacement();
+    double                booked = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      {
+        end_velocity[i] = (d.segment<2>(2 * i) / h - (1 - th) * begin_velocity[i]) / th;
+        booked += R.segment<2>(2 * i).dot(0.5 * (begin_velocity[i] + end_velocity[i]));
+      }
+    extra_work = R.dot(d) / h - booked;
+
+    // How well the linearisation predicted the chain's response.
+    const Eigen::VectorXd response = th * h * (G * R);
+    const double          scale    = response.lpNorm<Eigen::Infinity>();
+    last_miss = scale > 0 ? (d - free_displacement - response).lpNorm<Eigen::Infinity>() / scale : 0.0;
+    worst_miss = std::max(worst_miss, last_miss);
+    if (scale > 0)
+      {
+        miss_sum += last_miss;
+        ++steps_with_contacts;
+        real_response_work += R.dot(d - free_displacement);
+        predicted_response_work += R.dot(response);
+      }
+    ++steps;
+    if (last_miss > compliance_tolerance && steps >= built_at_step + compliance_min_interval)
+      stale = true;
+
+    time += h;
+    for (unsigned int i = 0; i < n; ++i)
       start[i] = unwrapped(i);
   }
 
-  std::string ParticleFirstBody::overlap_hint(double h) const
+  void ParticleFirstBody::start_shearing()
   {
-    const double s      = prm.length / chain.size();
-    const double c      = p_wave_speed(prm);
-    const double h_safe = particle_coupling_courant * s / c;
-    std::ostringstream os;
-    os << "With an " << prm.model << " upper body a grain that passes one radius may have gone through "
-       << "its chain, whose particles are kicked once per contact step and give way in between: "
-       << "here c_p h / s = " << c * h / s << " (c_p = " << c << " m/s, s = " << s << " m)";
-    if (c * h / s > 0.5 * particle_coupling_courant)
-      os << "; a smaller " << prm.time_step_entry << " holds them better (h = " << 0.5 * h_safe
-         << " s is half the coupling limit; docs/first_bodies.md)";
-    return os.str();
+    if (stop_damping())
+      stale = true;
+  }
+
+  void ParticleFirstBody::summarize(JsonObject &j) const
+  {
+    j.set("upper_body_steps", long(steps));
+    j.set("upper_body_compliance_builds", long(builds));
+    j.set("upper_body_linearisation_miss_max", worst_miss);
+    j.set("upper_body_linearisation_miss_mean", steps_with_contacts > 0 ? miss_sum / steps_with_contacts : 0.0);
+    j.set("upper_body_compliance_asymmetry", asymmetry);
+    j.set("upper_body_response_ratio",
+          predicted_response_work > 0 ? real_response_work / predicted_response_work : 0.0);
   }
 
   double ParticleFirstBody::mean_bottom_y() const
@@ -134,14 +232,32 @@ namespace tribo::coupling
     return e;
   }
 
-  void ParticleFirstBody::save_base(CheckpointOut &ar) const
+  void ParticleFirstBody::save(CheckpointOut &ar) const
   {
-    ar << time << step_h << load_work << dissipated << correction_work;
+    save_engine(ar);
+    ar << time << step_h << load_work << dissipated << extra_work << compliance_h << stale << builds << steps
+       << built_at_step << steps_with_contacts << miss_sum << worst_miss << asymmetry << real_response_work
+       << predicted_response_work;
+    const std::vector<double> g(G.data(), G.data() + G.size());
+    ar << g;
+    for (const dem::Vec2 &u : end_velocity)
+      ar << u.x() << u.y();
   }
 
-  void ParticleFirstBody::load_base(CheckpointIn &ar)
+  void ParticleFirstBody::load(CheckpointIn &ar)
   {
-    ar >> time >> step_h >> load_work >> dissipated >> correction_work;
+    load_engine(ar);
+    ar >> time >> step_h >> load_work >> dissipated >> extra_work >> compliance_h >> stale >> builds >> steps >>
+      built_at_step >> steps_with_contacts >> miss_sum >> worst_miss >> asymmetry >> real_response_work >>
+      predicted_response_work;
+    std::vector<double> g;
+    ar >> g;
+    if (g.size() != std::size_t(G.size()))
+      throw InputError("checkpoint: its particle-body compliance has " + std::to_string(g.size()) +
+                       " entries, this case's chain needs " + std::to_string(G.size()));
+    std::copy(g.begin(), g.end(), G.data());
+    for (dem::Vec2 &u : end_velocity)
+      ar >> u.x() >> u.y();
     for (unsigned int i = 0; i < chain.size(); ++i)
       start[i] = unwrapped(i);
   }

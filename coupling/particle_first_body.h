@@ -1,34 +1,39 @@
 #pragma once
-/// @file An explicit particle body (SPH or MLP) behind the coupling interface.
+/// @file A particle body (SPH or MLP) behind the coupling interface, its contact chain
+/// treated implicitly (docs/first_bodies.md, "Implicit chain").
 ///
-/// Coupling scheme (../shared/DESIGN.md section 3: boundary particles as contact sites
-/// with their lumped mass, sub-cycling of the explicit steps inside a contact step):
-/// - the chain nodes are the bottom row of particles, ordered by reference x;
-/// - predict(h) keeps the start positions, then advances the whole body over [t, t + h]
-///   with its own explicit integrator (several sub-steps, the top load applied) and no
-///   contact force: the end velocities of the chain particles are the free velocities;
-/// - the compliance is the lumped mass, G = diag(1/m_i): within one contact step an
-///   impulse moves only the particle it hits (the explicit body propagates it later);
-/// - finalize(R) kicks the chain particles at the end of the step as the Moreau-Jean
-///   scheme moves a node, v_i <- v_free,i + R_i / m_i and x_i <- x_i + theta h R_i / m_i
-///   (for theta = 1/2 what a constant force R_i / h over the step does to a free
-///   particle). Without the position term a chain that carries the pressure sinks into
-///   the grains by a h^2 / 2 per step (a = P s / m: 1.5e-8 m per step for steel at
-///   100 MPa, s = 2 um, h = 2 ns).
-/// Energy: the kick does the work R_i . (v_free,i + v_i) / 2, which the solver books
-/// with node_velocity() = v_free at the start of the NLGS and v_i after finalize();
-/// the position term changes the stored energy (mlp: the potential; sph: the elastic
-/// work of the stresses on the displacement, sph::Solver::displace()), reported as
-/// impulse_extra_power() and booked with the contact power. An sph body whose density
-/// did not see the position term thinned geometrically at theta h P / (rho s) while its
-/// pressure stayed (0.50 m/s measured against 0.48 predicted on the unit test's column).
-/// With the sub-cycle's own energy error (RK2, Verlet) the body's balance then closes. A chain particle held up by a contact oscillates
-/// within a step (its neighbours accelerate it, the contact stops it): the contacts
-/// dissipate about (P s h)^2 / (2 m) per chain particle and step, a coupling loss
-/// that shrinks with h^2 / m (docs/first_bodies.md gives the measured figure).
+/// The chain nodes are the bottom row of particles, ordered by reference x. The body's
+/// own integrator is explicit and sub-cycles inside a contact step [t, t + h]; the
+/// contact impulse R_i on chain particle i acts on it as the constant force R_i / h over
+/// the whole step, so the NSCD solve must know how the chain responds to it:
+/// - predict(h): keep the state S_0, advance the body over the step with the top load
+///   and no contact force: chain displacements d_free;
+/// - compliance: D = d(chain displacements)/d(impulses), the response of the sub-cycled
+///   dynamics linearised about S_0, one column per chain particle and direction by finite
+///   differences (advance from S_0 with the force eps e / h on that particle; eps = P s h,
+///   the impulse a chain particle carries over a step under the load P). For a linear undamped body with
+///   modes omega_k, D = sum_k phi_k phi_k^T (1 - cos omega_k h) / (omega_k^2 h): symmetric
+///   and positive semi-definite whatever omega_k h, so the solver gets
+///   G = sym(D) / (theta h) (-> diag(1 / m_i) when omega h -> 0, the lumped mass);
+/// - the velocities the solver sees are those that move the nodes as the Moreau-Jean
+///   scheme moves a node, x_1 = x_0 + h ((1 - theta) v_b + theta u): begin velocity
+///   v_b = the chain particles' velocities at the start, free velocity
+///   u_free = (d_free / h - (1 - theta) v_b) / theta, so that u = u_free + G R gives
+///   the linearised end positions d_free + D R exactly;
+/// - finalize(R): restore S_0 and advance the real nonlinear body with the forces
+///   R_i / h on the chain (kept as is when every R_i = 0). The chain's end velocities
+///   reported are u = (d / h - (1 - theta) v_b) / theta with the real displacements d.
+///   If the real displacements miss the linearised ones by more than
+///   compliance_tolerance of the contact response |D R|, the next step rebuilds D
+///   (at most once per compliance_min_interval steps); a new step size and the end of
+///   the compaction damping (start_shearing()) do too.
+/// Energy: the force R_i / h does the work R_i . d_i / h on the body; the solver books
+/// R_i . (v_b + u_i) / 2, which is the same at theta = 1/2; impulse_extra_power() carries
+/// the difference otherwise. The body's books then close to its integrator's error.
 
 #include "coupling/first_body.h"
 
+#include <string>
 #include <vector>
 
 namespace tribo::coupling
@@ -36,32 +41,61 @@ namespace tribo::coupling
   class ParticleFirstBody : public FirstBody
   {
   public:
+    /// Displacement of a free chain particle by the compliance probe of an unloaded body
+    /// (P = 0), in spacings; a loaded body is probed with P s h.
+    static constexpr double compliance_probe = 1e-5;
+    /// Largest miss of the linearised chain displacements, relative to the contact
+    /// response max_i |(D R)_i|, before D is rebuilt ...
+    static constexpr double compliance_tolerance = 0.05;
+    /// ... but not within this many steps of the last build: a build costs 2 n_nodes()
+    /// advances, and a miss that a fresh build does not remove (the sph body's artificial
+    /// viscosity acts on approaching pairs only, so its response is not linear even for a
+    /// small impulse: 7-18 % on the shear cell, docs/first_bodies.md) must not make every
+    /// step a build.
+    static constexpr unsigned long compliance_min_interval = 100;
+
     unsigned int n_nodes() const override { return chain.size(); }
     /// Position of chain particle i at the start of the step, unwrapped along x
     /// (within half a period of its reference abscissa), m.
     dem::Vec2 node_position(unsigned int i) const override { return start[i]; }
-    /// Current velocity of chain particle i: v_free after predict(), the end velocity
-    /// after finalize(), m/s.
-    dem::Vec2 node_velocity(unsigned int i) const override { return velocity(chain[i]); }
+    /// Between predict() and finalize(): the chain particle's velocity at the start of the
+    /// step, v_b; otherwise the end velocity u of the last step (file comment), m/s.
+    dem::Vec2 node_velocity(unsigned int i) const override { return in_step ? begin_velocity[i] : end_velocity[i]; }
     void      predict(double h) override;
     dem::Vec2 node_free_velocity(unsigned int i) const override { return free[i]; }
-    /// diag(1/m_i) over the chain, m/s per N s/m.
+    /// sym(D) / (theta h) over the chain, m/s per N s/m.
     const Eigen::MatrixXd &compliance() const override { return G; }
     void   finalize(const std::vector<dem::Vec2> &impulses) override;
     /// Work of the top load over the last step / h, W/m.
     double external_power() const override { return step_h > 0 ? load_work / step_h : 0.0; }
-    /// Energy removed by the compaction damping over the last step / h, W/m.
+    /// Energy removed by damping over the last step / h, W/m.
     double internal_dissipation() const override { return step_h > 0 ? dissipated / step_h : 0.0; }
-    /// Stored-energy change of finalize()'s position term / h, W/m.
-    double impulse_extra_power() const override { return step_h > 0 ? correction_work / step_h : 0.0; }
+    /// Work of the contact forces beyond what the solver books, / h, W/m.
+    double impulse_extra_power() const override { return step_h > 0 ? extra_work / step_h : 0.0; }
     double mean_bottom_y() const override;
     double mean_bottom_vy() const override;
     double kinetic_energy() const override;
-    /// Sub-steps of the last predict().
+    /// The body's state and the coupling's (compliance, step, last step's books).
+    void save(CheckpointOut &ar) const final;
+    void load(CheckpointIn &ar) final;
+    /// Drops the compaction damping (the scene calls it at every shearing step); the
+    /// compliance is rebuilt at the next step if there was damping to drop.
+    void start_shearing() final;
+    /// upper_body_steps, upper_body_compliance_builds, upper_body_linearisation_miss_max
+    /// and _mean (linearisation_error() over the steps with contacts),
+    /// upper_body_compliance_asymmetry (last build), upper_body_response_ratio (the real
+    /// body's displacement under the impulses against the predicted one, in work).
+    void summarize(JsonObject &j) const override;
+
+    /// Sub-steps of the last real advance.
     unsigned int last_substeps() const { return substeps; }
-    /// For the overlap guard: the chain's c_p h / s at step @p h (s) and, above half the
-    /// coupling limit, the step at half of it (particle_coupling_courant / 2).
-    std::string overlap_hint(double h) const override;
+    /// Compliance builds since construction (each costs 2 n_nodes() advances).
+    unsigned long compliance_builds() const { return builds; }
+    /// Miss of the last step's linearised chain displacements relative to the contact
+    /// response (0 without contacts).
+    double linearisation_error() const { return last_miss; }
+    /// ||D - D^T|| / ||D|| of the last build (Frobenius norms).
+    double compliance_asymmetry() const { return asymmetry; }
 
   protected:
     /// Engine hooks. Particle index p, all particles of the engine.
@@ -69,40 +103,57 @@ namespace tribo::coupling
     virtual dem::Vec2    position(unsigned int p) const               = 0; ///< m, wrapped
     virtual dem::Vec2    velocity(unsigned int p) const               = 0; ///< m/s
     virtual double       mass(unsigned int p) const                   = 0; ///< kg/m
-    /// v_p += dv_q, x_p += dx_q (wrapped into the period) for each p = @p p[q]; the
-    /// engine's state variables must follow the position change (sph: density, stress
-    /// and internal energy; mlp: its forces are functions of the positions).
-    virtual void kick(const std::vector<unsigned int> &p, const std::vector<dem::Vec2> &dv,
-                      const std::vector<dem::Vec2> &dx) = 0;
-    /// Set the force on each top particle to (0, @p load) N/m, advance the body by
-    /// @p h (s) and return the number of sub-steps.
-    virtual unsigned int advance(double h, double load) = 0;
-    /// Energy removed by damping since the start, J/m.
+    /// Advance the body by @p h (s) with the force (0, @p load) N/m on each top particle
+    /// and @p chain_force[i] (N/m) on chain particle i, both constant over the step;
+    /// returns the number of sub-steps.
+    virtual unsigned int advance(double h, double load, const std::vector<dem::Vec2> &chain_force) = 0;
+    /// Energy removed by damping (and, sph, the artificial viscosity's heat) since the start, J/m.
     virtual double total_dissipation() const = 0;
+    /// The engine's whole state (what a step carries to the next), for checkpoints and
+    /// for the restarts from S_0 within a step.
+    virtual void save_engine(CheckpointOut &ar) const = 0;
+    virtual void load_engine(CheckpointIn &ar)        = 0;
+    /// Drop the engine's compaction damping; false if it had none (left).
+    virtual bool stop_damping() = 0;
 
     /// To be called by the engine's constructor once its particles exist: the chain
     /// (bottom row, any order) and the loaded top row.
     void set_rows(const std::vector<unsigned int> &bottom, const std::vector<unsigned int> &top_row);
 
-    /// The checkpointed state of this class (time, chain start positions are rebuilt).
-    void save_base(CheckpointOut &ar) const;
-    void load_base(CheckpointIn &ar);
-
     FirstBodyParameters prm;
-    double              time = 0; ///< s, start of the next step
     std::vector<unsigned int> chain, top; ///< particle indices
     explicit ParticleFirstBody(const FirstBodyParameters &p) : prm(p) {}
 
   private:
     dem::Vec2 unwrapped(unsigned int i) const; ///< chain particle i, near its reference x
-    void      build_compliance(double h);
+    /// Chain displacements since the start of the step, flattened (2i: x, 2i + 1: y), m.
+    Eigen::VectorXd chain_displacement() const;
+    /// Top load per top particle at mid-step, N/m (compressive: < 0).
+    double top_load(double h) const;
+    /// D by finite differences from the saved state; leaves the engine off S_0's step.
+    void build_compliance(double h, double load);
+    std::string snapshot() const;
+    void        restore(const std::string &state);
 
-    std::vector<double>    reference_x;       ///< of the chain, increasing
-    std::vector<dem::Vec2> start, free;       ///< chain start positions, free velocities
-    std::vector<double>    top_start_y;       ///< top-row y at the start of the step
+    double                 time = 0;           ///< s, start of the next step
+    std::vector<double>    reference_x;        ///< of the chain, increasing
+    std::vector<dem::Vec2> start, free;        ///< chain start positions, free velocities
+    std::vector<dem::Vec2> begin_velocity, end_velocity; ///< v_b, u (file comment)
+    std::vector<double>    top_start_y;        ///< top-row y at the start of the step, m
+    Eigen::VectorXd        free_displacement;  ///< d_free, m
     Eigen::MatrixXd        G;
-    double                 compliance_h = 0; ///< step G was built for, s
-    double                 step_h = 0, load_work = 0, dissipated = 0, correction_work = 0;
+    std::string            start_state;        ///< S_0 (save_engine())
+    bool                   in_step = false;    ///< between predict() and finalize()
+    bool                   engine_free = false; ///< the engine holds the free end state
+    bool                   stale = true;        ///< rebuild G at the next predict()
+    double                 compliance_h = 0;    ///< step G was built for, s
+    double                 step_h = 0, step_load = 0, load_work = 0, dissipated = 0, extra_work = 0;
+    double                 dissipation_at_start = 0;
+    double                 last_miss = 0, worst_miss = 0, miss_sum = 0, asymmetry = 0;
+    /// sum over steps of R . (d - d_free) and R . D R, J/m x h: their ratio says whether
+    /// the real body yields more (> 1) or less than the compliance predicted.
+    double                 real_response_work = 0, predicted_response_work = 0;
+    unsigned long          builds = 0, steps = 0, built_at_step = 0, steps_with_contacts = 0;
     unsigned int           substeps = 0;
   };
 } // namespace tribo::coupling

@@ -63,6 +63,8 @@ namespace tribo::coupling
         sph::ExternalForce<2> load;
         load.particles = top_row;
         solver.external.push_back(load);
+        for (unsigned int p : chain) // the contact forces, external[1 + i] on chain particle i
+          solver.external.push_back({{p}, {}, 0});
         if (p.compaction_damping > 0)
           {
             sph::Damping d{0, 2 * p.compaction_damping * M_PI * p_wave_speed(p) / (2 * p.thickness)};
@@ -83,7 +85,6 @@ namespace tribo::coupling
       /// The elastic energy: the internal energy sum m e less the artificial viscosity's
       /// heat, which is booked as dissipation inside the body (total_dissipation()), J/m.
       double stored_energy() const override { return solver.state.internal_energy() - solver.viscous_heat(); }
-      void   start_shearing() override { solver.damping.clear(); }
 
       std::string write_fields(const std::string &dir, unsigned int index) const override
       {
@@ -108,46 +109,35 @@ namespace tribo::coupling
         return name;
       }
 
-      void save(CheckpointOut &ar) const override
-      {
-        ar << total_dissipation();
-        solver.save(ar);
-        save_base(ar);
-      }
-
-      void load(CheckpointIn &ar) override
-      {
-        double damped;
-        ar >> damped;
-        solver.load(ar);
-        dissipation_offset = damped - solver.damping_dissipation() - solver.viscous_heat();
-        load_base(ar);
-      }
-
     protected:
       unsigned int n_particles() const override { return solver.state.size(); }
       dem::Vec2    position(unsigned int p) const override { return {solver.state.x[p][0], solver.state.x[p][1]}; }
       dem::Vec2    velocity(unsigned int p) const override { return {solver.state.v[p][0], solver.state.v[p][1]}; }
       double       mass(unsigned int p) const override { return solver.state.mass[p]; }
-      /// The velocities change directly; the positions through sph::Solver::displace(),
-      /// so that the density, stress and internal energy see the position term.
-      void kick(const std::vector<unsigned int> &p, const std::vector<dem::Vec2> &dv,
-                const std::vector<dem::Vec2> &dx) override
-      {
-        auto                     &s = solver.state;
-        std::vector<Tensor<1, 2>> shift(p.size());
-        for (std::size_t q = 0; q < p.size(); ++q)
-          {
-            s.v[p[q]][0] += dv[q].x();
-            s.v[p[q]][1] += dv[q].y();
-            shift[q] = Tensor<1, 2>({dx[q].x(), dx[q].y()});
-          }
-        solver.displace(p, shift);
-      }
-      unsigned int advance(double h, double load) override
+      unsigned int advance(double h, double load, const std::vector<dem::Vec2> &chain_force) override
       {
         solver.external[0].force = Tensor<1, 2>({0, load});
+        for (std::size_t i = 0; i < chain_force.size(); ++i)
+          solver.external[1 + i].force = Tensor<1, 2>({chain_force[i].x(), chain_force[i].y()});
         return solver.advance_to(solver.time + h);
+      }
+      void save_engine(CheckpointOut &ar) const override
+      {
+        ar << total_dissipation();
+        solver.save(ar);
+      }
+      void load_engine(CheckpointIn &ar) override
+      {
+        double damped;
+        ar >> damped;
+        solver.load(ar);
+        dissipation_offset = damped - solver.damping_dissipation() - solver.viscous_heat();
+      }
+      bool stop_damping() override
+      {
+        const bool had = !solver.damping.empty();
+        solver.damping.clear();
+        return had;
       }
       /// The compaction damping's work and the artificial viscosity's heat, J/m.
       double total_dissipation() const override

@@ -193,33 +193,6 @@ namespace tribo::sph
   }
 
   template <int dim>
-  void Solver<dim>::displace(const std::vector<unsigned int> &particles, const std::vector<Tensor<1, dim>> &dx)
-  {
-    if (particles.size() != dx.size())
-      throw std::logic_error("SPH displace: " + std::to_string(dx.size()) + " displacements for " +
-                             std::to_string(particles.size()) + " particles");
-    mid   = state;
-    mid.v.assign(state.size(), Tensor<1, dim>());
-    for (std::size_t q = 0; q < particles.size(); ++q)
-      mid.v[particles[q]] = dx[q];
-    Rates<dim> u;
-    compute_rates(mid, time, u, false);
-    parallel_for(state.size(), [&](unsigned int i) {
-      state.rho[i] += u.drho[i];
-      state.e[i] += u.de[i];
-      state.S[i] += u.dS[i];
-    });
-    for (std::size_t q = 0; q < particles.size(); ++q)
-      {
-        auto &x = state.x[particles[q]];
-        x += dx[q];
-        if (prm.period > 0)
-          x[0] -= prm.period * std::floor(x[0] / prm.period);
-      }
-    check_finite(state, "after a displacement");
-  }
-
-  template <int dim>
   double Solver<dim>::stable_step(const ParticleState<dim> &s, const Rates<dim> &k,
                                   std::string &lim, std::vector<unsigned int> &worst) const
   {

@@ -166,16 +166,6 @@ namespace tribo::sph
     /// false the artificial viscosity is left out (Pi_ij = 0).
     void compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k, bool viscosity = true);
 
-    /// Moves particles @p particles by @p dx (m) outside the integrator, as the velocity
-    /// field u (u_i = dx_i for the listed particles, 0 elsewhere) acting for unit time
-    /// does to first order: x_i += dx_i, and for every particle within reach
-    /// rho_i += sum_j m_j (u_i - u_j).grad_i W_ij, S_i += 2G (eps(u) - tr eps(u)/3 I) + the
-    /// Jaumann terms, e_i += sum_j m_j (u_j - u_i).(sigma_i / rho_i^2).grad_i W_ij (the
-    /// elastic work; no viscosity). So the density, the stress and the stored energy see
-    /// the motion: a coupling that corrects positions after a step (the Moreau-Jean
-    /// position term of a kicked contact particle) would otherwise compress the body
-    /// geometrically while its pressure stays, at the speed of the summed corrections.
-    void displace(const std::vector<unsigned int> &particles, const std::vector<Tensor<1, dim>> &dx);
     /// The largest stable step for rates @p k at state @p s, s; @p limiter is set
     /// to "CFL" or "acceleration" and @p worst to the particles with the smallest
     /// steps (up to 5, smallest first).

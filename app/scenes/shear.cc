@@ -196,6 +196,7 @@ namespace tribo::app
                  << " steps each";
           averaging = note.str();
         }
+        upper_body->summarize(j);
         j.set("normal_force_mean", stat("lower_wall_normal_force").first);
         j.set("normal_force_stderr", stderr_of("lower_wall_normal_force"));
         j.set("normal_force_target", k.pressure * k.length);

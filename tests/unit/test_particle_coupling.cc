@@ -1,9 +1,13 @@
-// The explicit particle first bodies (sph, mlp; coupling/particle_first_body.h) on a
-// column of grains resting on a fixed rigid wall, under top pressure: the body must
-// settle at its elastic thickness and stay there, and the energy of grains and body
-// must follow the work of the load, the contacts and the damping step by step.
-#include "coupling/first_body.h"
+// The particle first bodies (sph, mlp; coupling/particle_first_body.h) with their chain
+// treated implicitly: the compliance they give the solver (its limits and how well it
+// predicts the body's real response), and a column of grains resting on a fixed rigid
+// wall under top pressure, at a contact step four times the chain's own wave crossing:
+// the body must settle at its elastic thickness and stay there, and the energy of grains
+// and body must follow the work of the load, the contacts and the damping step by step.
+#include "coupling/particle_first_body.h"
 #include "dem/moreau_jean.h"
+
+#include <Eigen/Eigenvalues>
 
 #include <gtest/gtest.h>
 
@@ -16,6 +20,33 @@ namespace
 {
   constexpr double s = 1e-6, L = 8 * s, rho = 7800, P = 1e8, E = 1e11, nu = 0.25;
   const double     y_grain = 0.5 * std::sqrt(3.0) * s;
+
+  /// The body of the column below: 8 particles across, 10 s thick, chain at @p bottom.
+  coupling::FirstBodyParameters column_body(const std::string &model, double h, double bottom)
+  {
+    coupling::FirstBodyParameters p;
+    p.model = model;
+    p.length = L;
+    p.thickness = 10 * s;
+    p.bottom = bottom;
+    p.youngs_modulus = E;
+    p.poisson_ratio = nu;
+    p.density = rho;
+    p.resolution = s;
+    p.time_step = h;
+    p.pressure = P;
+    p.pressure_ramp_time = 2e-8;
+    p.compaction_damping = 1;
+    coupling::check_first_body(p);
+    return p;
+  }
+
+  /// h for the chain's c_p h / s = @p courant.
+  double step_for(double courant)
+  {
+    coupling::FirstBodyParameters p = column_body("mlp", 1, 0);
+    return courant * s / coupling::p_wave_speed(p);
+  }
 
   /// What a run of the column measured.
   struct ColumnRun
@@ -30,9 +61,9 @@ namespace
 
   /// 8 wall discs (radius s/2) at x = i s, y = 0, one grain in each pocket, and the
   /// body's chain (spacing s, 8 particles, bottom row at y_grain + s) just touching the
-  /// grains from above. h = 7.5e-11 s (c_p h / s = 0.29), load ramped over 20 ns,
-  /// compaction damping (zeta = 1) until 0.3 us, then @p steps steps in all.
-  ColumnRun run_column(const std::string &model, unsigned int steps)
+  /// grains from above. Step @p h, load ramped over 20 ns, compaction damping (zeta = 1)
+  /// until 0.3 us, then @p steps steps in all.
+  ColumnRun run_column(const std::string &model, double h, unsigned int steps)
   {
     dem::ParticleSystem sys;
     sys.period = L;
@@ -49,22 +80,7 @@ namespace
     for (int i = 0; i < 8; ++i)
       sys.add_disc({(i + 0.5) * s, y_grain}, 0.5 * s, rho);
 
-    const double h = 7.5e-11;
-    coupling::FirstBodyParameters p;
-    p.model = model;
-    p.length = L;
-    p.thickness = 10 * s;
-    p.bottom = y_grain + s;
-    p.youngs_modulus = E;
-    p.poisson_ratio = nu;
-    p.density = rho;
-    p.resolution = s;
-    p.time_step = h;
-    p.pressure = P;
-    p.pressure_ramp_time = 2e-8;
-    p.compaction_damping = 1;
-    coupling::check_first_body(p);
-    auto body = coupling::make_first_body(p);
+    auto body = coupling::make_first_body(column_body(model, h, y_grain + s));
 
     dem::SolverParameters nlgs;
     nlgs.tolerance = 1e-8;
@@ -117,59 +133,105 @@ namespace
   }
 
   /// The wall carries P L, the top does not sink, the books close per step within 10 % of
-  /// a step's mean work, and the sub-cycles lose less than 10 % of what the contacts dissipate.
+  /// a step's mean work and over the run within 1e-3 of the summed work, of which the
+  /// body's sub-cycles lose less than 1 % of what the contacts dissipate.
   void expect_column_holds(const ColumnRun &run)
   {
     EXPECT_NEAR(run.wall_force, 1.0, 0.02);
-    EXPECT_LT(std::abs(run.top_speed), 0.02) << "the block keeps thinning (m/s)";
+    EXPECT_LT(std::abs(run.top_speed), 0.05) << "the block keeps thinning (m/s)";
     EXPECT_LT(run.worst_balance, 0.1);
-    EXPECT_LT(std::abs(run.integrator_loss), 0.1);
+    EXPECT_LT(std::abs(run.window_balance), 1e-3);
+    EXPECT_LT(std::abs(run.integrator_loss), 0.01);
+  }
+
+  /// What the compliance of a body at rest, its top just loaded by P, is at c_p h / s = courant.
+  struct Compliance
+  {
+    double lumped_min = 0, lumped_max = 0; ///< G_kk m over the chain
+    double eigen_min = 0;                  ///< smallest eigenvalue of G / largest
+    double asymmetry = 0;                  ///< ||D - D^T|| / ||D|| before symmetrising
+    double miss = 0;                       ///< the real response against G's prediction
+  };
+
+  Compliance compliance_of(const std::string &model, double courant)
+  {
+    const double h = step_for(courant);
+    auto         p = column_body(model, h, 0);
+    p.pressure_ramp_time = 0;
+    p.compaction_damping = 0;
+    auto  body = coupling::make_first_body(p);
+    auto &particles = dynamic_cast<coupling::ParticleFirstBody &>(*body);
+    body->predict(h);
+    const Eigen::MatrixXd G = body->compliance();
+    // Lumped mass of a chain particle: rho s^2 (sph, square lattice), rho s^2 sqrt(3) / 2 (mlp).
+    const double m = rho * s * s * (model == "mlp" ? 0.5 * std::sqrt(3.0) : 1.0);
+    Compliance   out;
+    out.lumped_min = (G.diagonal() * m).minCoeff();
+    out.lumped_max = (G.diagonal() * m).maxCoeff();
+    const Eigen::VectorXd lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G).eigenvalues();
+    out.eigen_min = lambda.minCoeff() / lambda.maxCoeff();
+    out.asymmetry = particles.compliance_asymmetry();
+    // A grain pushing chain particle 3 up and sideways with P s h, its neighbour less.
+    std::vector<Vec2> R(body->n_nodes(), Vec2::Zero());
+    R[3] = Vec2(0.3, 1) * P * s * h;
+    R[4] = Vec2(-0.1, 0.5) * P * s * h;
+    body->finalize(R);
+    out.miss = particles.linearisation_error();
+    std::printf("%s at c_p h / s = %g: G_kk m in [%.4f, %.4f], eigenvalues down to %.3g of the largest, "
+                "asymmetry %.3g, linearisation miss %.3g\n",
+                model.c_str(), courant, out.lumped_min, out.lumped_max, out.eigen_min, out.asymmetry, out.miss);
+    return out;
+  }
+
+  /// Short steps: the lumped mass (the body cannot respond within the step). Long steps:
+  /// the compliance falls (the neighbours carry the impulse within the step), stays
+  /// positive semi-definite, and predicts the real nonlinear body's chain to
+  /// @p long_miss, its finite-difference D symmetric to @p long_asymmetry.
+  void expect_compliance_limits(const std::string &model, double long_asymmetry, double long_miss)
+  {
+    const Compliance short_step = compliance_of(model, 0.02);
+    EXPECT_GT(short_step.lumped_min, 0.99);
+    EXPECT_LT(short_step.lumped_max, 1.0 + 1e-6);
+    const Compliance long_step = compliance_of(model, 4);
+    EXPECT_LT(long_step.lumped_max, 0.5);
+    EXPECT_GT(long_step.eigen_min, -1e-12);
+    EXPECT_LT(short_step.asymmetry, 1e-6);
+    EXPECT_LT(short_step.miss, 1e-6);
+    EXPECT_LT(long_step.asymmetry, long_asymmetry);
+    EXPECT_LT(long_step.miss, long_miss);
   }
 } // namespace
 
 #ifdef TRIBO_TEST_SPH
-TEST(ParticleCoupling, SphBodyOnGrainsKeepsItsThickness)
+TEST(ParticleCoupling, SphComplianceFromLumpedMassToTheBodysResponse)
 {
-  // 1.5 us. Before sph::Solver::displace() carried the position term into the density,
-  // the block thinned at theta h P / (rho s) = 0.48 m/s (measured 0.50).
-  // The books: each contact step the chain falls freely inside predict() and is caught;
-  // the sub-cycles' energy error on that fall has one sign (RK2 here: 7 % of what the
-  // contacts dissipate in this resting column, 0.5 % of the input in the shear cell).
-  expect_column_holds(run_column("sph", 20000));
+  // The Monaghan viscosity acts on approaching pairs only, so the response of a body at
+  // rest depends on the impulse's direction: measured asymmetry 0.23 and miss 0.068
+  // (0.023 and 0.0098 with the viscosity off), docs/first_bodies.md.
+  expect_compliance_limits("sph", 0.3, 0.1);
+}
+
+TEST(ParticleCoupling, SphBodyOnGrainsKeepsItsThicknessAtFourWaveCrossingsPerStep)
+{
+  // 1.5 us at c_p h / s = 4. With the explicit chain (kicked once per contact step, until
+  // 2026-11-25) this needed c_p h / s <= 1, and at 0.29 the sub-cycles lost 7 % of what the
+  // contacts dissipate.
+  expect_column_holds(run_column("sph", step_for(4), 1500));
 }
 #endif
 
 #ifdef TRIBO_TEST_MLP
-TEST(ParticleCoupling, MlpBodyOnGrainsKeepsItsThickness)
+TEST(ParticleCoupling, MlpComplianceFromLumpedMassToTheBodysResponse)
 {
-  // Verlet at a twentieth of its limit: the fall-and-catch loss is 6 % of the contacts'
-  // dissipation here (17 % at a tenth of the limit).
-  expect_column_holds(run_column("mlp", 20000));
+  // Conservative: D is symmetric but for the Morse bonds' nonlinearity over the probe
+  // P s h (measured 0.0037; 5e-6 with a probe of 1e-5 s), which also sets the miss
+  // (measured 0.0015; 0.0048 with the small probe).
+  expect_compliance_limits("mlp", 0.01, 0.01);
 }
-#endif
 
-#ifdef TRIBO_TEST_MLP
-TEST(ParticleCoupling, OverlapHintNamesTheChainsCourantNumber)
+TEST(ParticleCoupling, MlpBodyOnGrainsKeepsItsThicknessAtFourWaveCrossingsPerStep)
 {
-  // What the overlap guard adds for a particle body: its c_p h / s and a step that holds.
-  coupling::FirstBodyParameters p;
-  p.model = "mlp";
-  p.length = L;
-  p.thickness = 10 * s;
-  p.youngs_modulus = E;
-  p.poisson_ratio = nu;
-  p.density = rho;
-  p.resolution = s;
-  p.time_step = 2e-10;
-  p.pressure = P;
-  const auto   body = coupling::make_first_body(p);
-  const double c    = coupling::p_wave_speed(p); // 3922 m/s
-  EXPECT_NEAR(c, std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu) * rho)), 1e-9 * c);
-  const std::string hint = body->overlap_hint(2e-10);
-  EXPECT_NE(hint.find("With an mlp upper body a grain that passes one radius may have gone through its chain"),
-            std::string::npos) << hint;
-  EXPECT_NE(hint.find("here c_p h / s = 0.784465 (c_p = 3922.32 m/s, s = 1e-06 m)"), std::string::npos) << hint;
-  EXPECT_NE(hint.find("h = 1.27475e-10 s is half the coupling limit"), std::string::npos) << hint;
-  EXPECT_EQ(body->overlap_hint(2e-11).find("half the coupling limit"), std::string::npos);
+  // As sph; the explicit chain's sub-cycles lost 6 % of the contacts' dissipation at 0.29.
+  expect_column_holds(run_column("mlp", step_for(4), 1500));
 }
 #endif

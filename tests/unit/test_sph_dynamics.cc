@@ -373,53 +373,6 @@ TEST(SphDynamics, ResultsIndependentOfThreadCount)
     EXPECT_EQ((v_end[0][i] - v_end[1][i]).norm(), 0.0) << i;
 }
 
-TEST(SphDynamics, DisplacementIsSeenByDensityStressAndEnergy)
-{
-  // A strip periodic in x under a uniform pressure P0 (rho = rho0 (1 + P0/K)), displaced
-  // outside the integrator by the uniaxial strain eps_yy = -eps (u_i = -eps (y_i - y_mid)):
-  // in the interior rho grows by rho eps, S_yy by -4/3 G eps, S_xx by 2/3 G eps, e by
-  // P0 eps / rho (the work P dV); a rigid translation changes nothing.
-  SolverParameters prm;
-  const double     a = 1e-3, L = 16 * a, H = 16 * a, eps = 1e-6, K = 26.7e9, G = 22.7e9;
-  prm.period       = L;
-  auto s = make_block<2>(vec<2>(L, H), a, LatticeType::cubic, prm, rock);
-  const double rho = s.state.rho[0] * (1 + 1e-3), P0 = K * 1e-3;
-  for (auto &r : s.state.rho)
-    r = rho;
-  const ParticleState<2> before = s.state;
-
-  std::vector<unsigned int> all(s.state.size());
-  std::vector<Tensor<1, 2>> shift(s.state.size()), translation(s.state.size(), vec<2>(0.3 * a, -0.2 * a));
-  for (unsigned int i = 0; i < s.state.size(); ++i)
-    {
-      all[i]   = i;
-      shift[i] = vec<2>(0, -eps * (s.state.x[i][1] - 0.5 * H));
-    }
-  s.displace(all, translation);
-  for (unsigned int i = 0; i < s.state.size(); ++i)
-    {
-      EXPECT_NEAR(s.state.rho[i], rho, 1e-12 * rho) << i;
-      EXPECT_NEAR(s.state.e[i], 0.0, 1e-12) << i;
-      EXPECT_NEAR(s.state.S[i][1][1], 0.0, 1e-6) << i;
-    }
-  s.state = before;
-  s.displace(all, shift);
-  unsigned int interior = 0;
-  for (unsigned int i = 0; i < s.state.size(); ++i)
-    {
-      EXPECT_NEAR(s.state.x[i][1] - before.x[i][1], shift[i][1], 1e-15);
-      const double y = before.x[i][1];
-      if (y < 3 * a || y > H - 3 * a)
-        continue; // within the kernel support of a free surface
-      ++interior;
-      EXPECT_NEAR((s.state.rho[i] - rho) / (rho * eps), 1.0, 0.02) << i;
-      EXPECT_NEAR(s.state.S[i][1][1] / (-4.0 / 3 * G * eps), 1.0, 1e-6) << i;
-      EXPECT_NEAR(s.state.S[i][0][0] / (2.0 / 3 * G * eps), 1.0, 1e-6) << i;
-      EXPECT_NEAR(s.state.e[i] / (P0 * eps / rho), 1.0, 0.02) << i;
-    }
-  EXPECT_EQ(interior, 16u * 10u);
-}
-
 TEST(SphDynamics, ImposedComponentMovesExactlyAndItsImpulseIsTheMomentumGiven)
 {
   // A block at rest whose top two layers are pushed along x at V (x imposed, the other
