@@ -4,6 +4,10 @@
 #include "app/scene.h"
 #include "core/output.h"
 
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
+#include <boost/serialization/vector.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -175,12 +179,25 @@ namespace tribo::app
           ("power_free", r.power_free)("power_contacts", r.power_contacts);
         scene->measure(system, *mj, r, last);
         measured = true;
+        const auto &columns = last.columns();
+        power_sums.resize(columns.size(), 0.0);
+        for (std::size_t c = 0; c < columns.size(); ++c)
+          if (is_power(columns[c].first))
+            power_sums[c] += columns[c].second;
+        ++power_steps;
       }
 
+      /// The columns of the last step; the power_* columns as their means over the steps
+      /// since the previous row, so that a row every N steps carries the work of all N
+      /// (a power that alternates from step to step would alias otherwise).
       bool row(Row &row) override
       {
-        for (const auto &[name, value] : last.columns())
-          row(name, value);
+        const auto &columns = last.columns();
+        for (std::size_t c = 0; c < columns.size(); ++c)
+          row(columns[c].first, is_power(columns[c].first) && power_steps > 1 ? power_sums[c] / power_steps
+                                                                              : columns[c].second);
+        power_sums.assign(power_sums.size(), 0.0);
+        power_steps = 0;
         return measured;
       }
       bool row_due(unsigned long s) override { return s % prm.statistics_interval == 0; }
@@ -306,6 +323,7 @@ namespace tribo::app
         system.save(ar);
         mj->save(ar);
         scene->save(ar);
+        ar << power_sums << power_steps;
       }
       void load(CheckpointIn &ar, unsigned long s) override
       {
@@ -314,6 +332,7 @@ namespace tribo::app
         system.load(ar);
         mj->load(ar);
         scene->load(ar);
+        ar >> power_sums >> power_steps;
       }
 
     private:
@@ -328,6 +347,10 @@ namespace tribo::app
       StepTiming                       timing; ///< the steps since the start or the last resumption
       Row                              last;   ///< the columns measured after the last step
       bool                             measured = false;
+      std::vector<double>              power_sums;      ///< per column of last, power_* only, W/m
+      unsigned long                    power_steps = 0; ///< steps summed into power_sums
+
+      static bool is_power(const std::string &column) { return column.rfind("power_", 0) == 0; }
     };
   } // namespace
 
