@@ -27,11 +27,13 @@ namespace tribo::coupling
     /// i.e. nu <= 1/4, because return forces can only lower nu' below 1/3.
     /// Velocity Verlet (BAOAB at T = 0) with the largest step that divides h and is at
     /// most verlet_fraction of the stability limit 2 / omega_max of the stiffest bond.
-    /// On the resting column of tests/unit/test_particle_coupling.cc at c_p h / s = 4 the
-    /// books close to 5e-4 of the contacts' dissipation with a twentieth of the limit and
-    /// to 7e-3 with a fifth (before the implicit chain, the chain's fall-and-catch in each
-    /// step lost 1 % on the shear cell with a twentieth, 40 % with a half). Compaction
-    /// damping: the Langevin friction eta = m gamma, gamma = 2 zeta omega_1.
+    /// A twentieth: on the resting column of tests/unit/test_particle_coupling.cc at
+    /// c_p h / s = 4 the sub-cycles lose 6e-4 of the contacts' dissipation, 1.35e-2 with a
+    /// fifth; on the 120-disc shear cell the books close to 0.03 % (0.17 % with a fifth,
+    /// 3.5 times faster; docs/first_bodies.md). Before the implicit chain, its
+    /// fall-and-catch in each step lost 1 % on the shear cell with a twentieth, 40 % with
+    /// a half. Compaction damping: the Langevin friction eta = m gamma,
+    /// gamma = 2 zeta omega_1.
     class MlpFirstBody : public ParticleFirstBody
     {
       static constexpr double verlet_fraction = 0.05;
