@@ -70,6 +70,9 @@ namespace tribo::coupling
     double       compaction_damping = 0;
     /// Smoothing length over spacing (sph).
     double       smoothing_ratio = 1.2;
+    /// Velocity-Verlet step of the mlp body over its stability limit 2 / omega_max (the
+    /// largest step that divides the contact step and is at most this fraction of it).
+    double       verlet_fraction = 0.05;
     /// The case subsection the body's entries were read from: messages name them
     /// through it.
     ParameterSection section;

@@ -26,18 +26,16 @@ namespace tribo::coupling
     /// target, conservative return forces so that the energy is defined). nu' <= 1/3,
     /// i.e. nu <= 1/4, because return forces can only lower nu' below 1/3.
     /// Velocity Verlet (BAOAB at T = 0) with the largest step that divides h and is at
-    /// most verlet_fraction of the stability limit 2 / omega_max of the stiffest bond.
-    /// A twentieth: on the resting column of tests/unit/test_particle_coupling.cc at
-    /// c_p h / s = 4 the sub-cycles lose 6e-4 of the contacts' dissipation, 1.35e-2 with a
-    /// fifth; on the 120-disc shear cell the books close to 0.03 % (0.17 % with a fifth,
-    /// 3.5 times faster; docs/first_bodies.md). Before the implicit chain, its
-    /// fall-and-catch in each step lost 1 % on the shear cell with a twentieth, 40 % with
-    /// a half. Compaction damping: the Langevin friction eta = m gamma,
-    /// gamma = 2 zeta omega_1.
+    /// most FirstBodyParameters::verlet_fraction of the stability limit 2 / omega_max of
+    /// the stiffest bond. At the default, a twentieth, the resting column of
+    /// tests/unit/test_particle_coupling.cc (c_p h / s = 4) loses 6e-4 of the contacts'
+    /// dissipation in its sub-cycles (1.35e-2 at a fifth) and the 120-disc shear cell's
+    /// books close to 0.03 % (0.17 % at a fifth, 3.5 times faster; docs/first_bodies.md).
+    /// Before the implicit chain, its fall-and-catch in each step lost 1 % on the shear
+    /// cell at a twentieth, 40 % at a half. Compaction damping: the Langevin friction
+    /// eta = m gamma, gamma = 2 zeta omega_1.
     class MlpFirstBody : public ParticleFirstBody
     {
-      static constexpr double verlet_fraction = 0.05;
-
     public:
       explicit MlpFirstBody(const FirstBodyParameters &p)
         : ParticleFirstBody(p), forces(interaction(p))
@@ -165,11 +163,11 @@ namespace tribo::coupling
         return ip;
       }
 
-      /// A Verlet step of at most verlet_fraction of the stability limit that divides @p h.
+      /// A Verlet step of at most prm.verlet_fraction of the stability limit that divides @p h.
       void build_integrator(double h)
       {
         const double carried = integrator ? total_dissipation() : dissipation_offset;
-        substeps_per_step     = std::max(1.0, std::ceil(h / (verlet_fraction * 2 / omega_max)));
+        substeps_per_step     = std::max(1.0, std::ceil(h / (prm.verlet_fraction * 2 / omega_max)));
         mlp::LangevinParameters lp;
         lp.time_step = h / substeps_per_step;
         lp.damping   = gamma * particles.mass[0];

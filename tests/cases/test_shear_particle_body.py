@@ -22,8 +22,8 @@ c_p h / s <= 1 and ran this test at 4e-10 s):
   half a grain radius);
 - the compliance: built once for the compaction and once when its damping goes, its
   linearisation within 5 % of the body's real response at every step;
-- the guard: a Poisson ratio above 1/4 is refused before anything is written, naming
-  the entry and a value that works.
+- the guards: a Poisson ratio above 1/4 and a Verlet fraction above 0.5 are refused
+  before anything is written, naming the entry and what is expected.
 
 Usage: test_shear_particle_body.py PATH/TO/tribo
 """
@@ -130,6 +130,11 @@ class Guards(unittest.TestCase):
             self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
             self.assertFalse(os.path.exists(out))
             return p.stderr
+
+    def test_a_verlet_fraction_beyond_half_the_limit_is_refused(self):
+        err = self.run_refused(MLP + ["--set", "Shear cell/Upper body Verlet fraction=0.7"])
+        self.assertIn("entry 'Shear cell/Upper body Verlet fraction' = '0.7': expected a fraction of the "
+                      "stability limit in (0, 0.5]", err)
 
     def test_a_poisson_ratio_above_one_quarter_is_refused(self):
         err = self.run_refused(["--set", "Shear cell/Upper body model=mlp"])
