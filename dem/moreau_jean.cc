@@ -21,6 +21,7 @@ namespace tribo::dem
     , solver(solver)
     , active_set(solver)
     , mprgp(solver)
+    , apgd(solver)
     , interior_point(solver)
     , predictor([&] {
       SolverParameters p = solver;
@@ -62,11 +63,11 @@ namespace tribo::dem
     unsigned int            sweeps   = 0;
     if (controls.predictor_sweeps > 0)
       sweeps = predictor.solve(current, state, contact_law, th * h).iterations;
-    if (controls.method == SolverParameters::Method::mprgp ||
-        controls.method == SolverParameters::Method::interior_point)
+    if (controls.method != SolverParameters::Method::active_set)
       {
-        SolveReport report = controls.method == SolverParameters::Method::mprgp
-                               ? mprgp.solve(current, state, contact_law)
+        SolveReport report = controls.method == SolverParameters::Method::mprgp ? mprgp.solve(current, state, contact_law)
+                             : controls.method == SolverParameters::Method::apgd
+                               ? apgd.solve(current, state, contact_law)
                                : interior_point.solve(current, state, contact_law);
         report.iterations += sweeps;
         return report;

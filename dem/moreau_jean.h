@@ -14,6 +14,7 @@
 /// compute_contact_powers(), check_overlaps().
 
 #include "dem/active_set.h"
+#include "dem/apgd.h"
 #include "dem/boundary.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
@@ -170,6 +171,7 @@ namespace tribo::dem
     NlgsSolver               solver;
     ActiveSetSolver          active_set;
     MprgpSolver              mprgp;
+    ApgdSolver               apgd;
     InteriorPointSolver      interior_point;
     NlgsSolver               predictor; ///< the active set's predictor sweeps
     double                   distance;

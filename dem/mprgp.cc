@@ -1,8 +1,6 @@
 #include "dem/mprgp.h"
 
-#include "dem/frictionless_problem.h"
-
-#include <deal.II/base/parallel.h>
+#include "dem/scaled_operator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,31 +11,6 @@ namespace tribo::dem
   namespace
   {
     using Index = Eigen::Index;
-
-    /// Entries per chunk of the fused passes: partial results are made per chunk and
-    /// added in chunk order, so the result is the same for any number of threads.
-    constexpr Index chunk_size = 256;
-
-    /// Run @p body(begin, end) -> Partial over fixed chunks of [0, n), concurrently when
-    /// @p threads > 1, and merge the partials in chunk order.
-    template <typename Partial, typename Body>
-    Partial over_chunks(Index n, unsigned int threads, const Body &body)
-    {
-      const Index          count = (n + chunk_size - 1) / chunk_size;
-      std::vector<Partial> partial(count);
-      auto                 work = [&](Index first, Index last) {
-        for (Index c = first; c < last; ++c)
-          partial[c] = body(c * chunk_size, std::min(n, (c + 1) * chunk_size));
-      };
-      if (threads > 1 && count > 1)
-        dealii::parallel::apply_to_subranges(Index(0), count, work, 1);
-      else
-        work(0, count);
-      Partial total;
-      for (const Partial &p : partial)
-        total.merge(p);
-      return total;
-    }
 
     /// Reductions of a product pass: p.A'p, g.p and the largest feasible step along -p.
     struct ProductSums
@@ -71,47 +44,6 @@ namespace tribo::dem
         phi_Ap += o.phi_Ap;
       }
     };
-    /// U' (n x k), nonzero only in the rows of the walls' contacts, kept by rows so that
-    /// its part of a product costs O(wall contacts), not O(n k).
-    class LowRankRows
-    {
-    public:
-      explicit LowRankRows(const Eigen::MatrixXd &U) : start(U.rows() + 1, 0)
-      {
-        for (Index j = 0; j < U.rows(); ++j)
-          {
-            for (Index k = 0; k < U.cols(); ++k)
-              if (U(j, k) != 0)
-                {
-                  column.push_back(k);
-                  value.push_back(U(j, k));
-                }
-            start[j + 1] = static_cast<Index>(value.size());
-            if (start[j + 1] > start[j])
-              rows.push_back(j);
-          }
-      }
-      /// @p t = U'^T @p v.
-      void transpose_times(const Eigen::VectorXd &v, Eigen::VectorXd &t) const
-      {
-        t.setZero();
-        for (const Index j : rows)
-          for (Index q = start[j]; q < start[j + 1]; ++q)
-            t[column[q]] += value[q] * v[j];
-      }
-      /// (U' @p t)_j.
-      double row_times(Index j, const Eigen::VectorXd &t) const
-      {
-        double sum = 0;
-        for (Index q = start[j]; q < start[j + 1]; ++q)
-          sum += value[q] * t[column[q]];
-        return sum;
-      }
-
-    private:
-      std::vector<Index>  start, rows, column;
-      std::vector<double> value;
-    };
   } // namespace
 
   SolveReport MprgpSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
@@ -124,36 +56,14 @@ namespace tribo::dem
     // The scaled problem (file comment).
     FrictionlessProblem::Scaled       scaled   = lcp.scaled();
     const Eigen::VectorXd            &inv_root = scaled.inv_root;
-    const Eigen::SparseMatrix<double> &A        = scaled.A;
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
-    double norm_bound        = 0; // ||A'|| <= max absolute column sum
-    for (Index j = 0; j < n; ++j)
-      {
-        double sum = 0;
-        for (Eigen::SparseMatrix<double>::InnerIterator a(A, j); a; ++a)
-          sum += std::abs(a.value());
-        norm_bound = std::max(norm_bound, sum);
-      }
-    norm_bound += scaled.U.squaredNorm(); // ||U'U'^T|| <= ||U'||_F^2
-    const double          alpha     = 1.9 / norm_bound;
-    const double          gamma2    = 1.0; // Gamma^2
-    const unsigned int    threads   = prm.threads;
-
-    // Column j of the symmetric A' is its row j: ((A' + U'U'^T) v)_j from column j alone,
-    // once Ut_v = U'^T v is known (set_low_rank_product).
-    const int         *start = A.outerIndexPtr();
-    const int         *row   = A.innerIndexPtr();
-    const double      *value = A.valuePtr();
-    const LowRankRows  U(scaled.U);
-    Eigen::VectorXd    Ut_v(scaled.U.cols());
-    auto               set_low_rank_product = [&](const Eigen::VectorXd &v) { U.transpose_times(v, Ut_v); };
-    auto times = [&](const Eigen::VectorXd &v, Index j) {
-      double sum = 0;
-      for (int k = start[j]; k < start[j + 1]; ++k)
-        sum += value[k] * v[row[k]];
-      return sum + U.row_times(j, Ut_v);
-    };
+    ScaledOperator     op(scaled);
+    const double       alpha   = 1.9 / op.norm_bound();
+    const double       gamma2  = 1.0; // Gamma^2
+    const unsigned int threads = prm.threads;
+    auto set_low_rank_product = [&](const Eigen::VectorXd &v) { op.set_vector(v); };
+    auto times                = [&](const Eigen::VectorXd &v, Index j) { return op.row_times(v, j); };
 
     Eigen::VectorXd g(n), p(n), Ap(n), phi(n), beta(n);
     // phi_j, beta_j and the split sums of entry j; with @p Ap_known, also phi.A'p.

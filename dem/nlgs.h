@@ -37,15 +37,17 @@ namespace tribo::dem
   {
     /// The method: nonlinear Gauss-Seidel (below); on the frictionless problem, the
     /// active-set (projected Newton) method with the sparse Delassus operator factorised
-    /// by CHOLMOD (dem/active_set.h), the matrix-free MPRGP (dem/mprgp.h) or the
-    /// primal-dual interior-point method, also with CHOLMOD (dem/interior_point.h). With
+    /// by CHOLMOD (dem/active_set.h), the matrix-free MPRGP (dem/mprgp.h) and APGD
+    /// (dem/apgd.h) or the primal-dual interior-point method, also with CHOLMOD
+    /// (dem/interior_point.h). With
     /// friction the global methods hand the step to NLGS and say so.
     enum class Method
     {
       nlgs,
       active_set,
       mprgp,
-      interior_point
+      interior_point,
+      apgd
     };
     Method method = Method::nlgs;
     /// Active set: relative regularisation delta of the Newton matrix W_FF + delta
@@ -138,6 +140,8 @@ namespace tribo::dem
           return "mprgp";
         case SolverParameters::Method::interior_point:
           return "interior-point";
+        case SolverParameters::Method::apgd:
+          return "apgd";
         default:
           return "nlgs";
       }

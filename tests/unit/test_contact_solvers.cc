@@ -61,7 +61,7 @@ namespace
     return p;
   }
 
-  /// The global methods, each to a law residual of 1e-11 (MPRGP: up to 1e5 products; the
+  /// The global methods, each to a law residual of 1e-11 (MPRGP, APGD: up to 1e5 products; the
   /// interior-point method stops at its round-off floor, reported not converged).
   std::vector<SolverParameters> global_methods()
   {
@@ -72,7 +72,9 @@ namespace
     SolverParameters interior_point;
     interior_point.method          = SolverParameters::Method::interior_point;
     interior_point.residual_target = 1e-11;
-    return {active_set(), mprgp, interior_point};
+    SolverParameters apgd = mprgp;
+    apgd.method           = SolverParameters::Method::apgd;
+    return {active_set(), mprgp, interior_point, apgd};
   }
 
   /// The law residual @p prm's method reaches when asked for 1e-11: the interior-point
@@ -204,8 +206,10 @@ TEST(ContactSolvers, GlobalMethodsWithTheWallAsLowRankMatchConvergedNlgs)
   mprgp.method          = SolverParameters::Method::mprgp;
   mprgp.residual_target = 1e-11;
   mprgp.max_iterations  = 100000;
+  SolverParameters apgd = mprgp;
+  apgd.method           = SolverParameters::Method::apgd;
   const Eigen::VectorXd v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 3);
-  for (const SolverParameters &prm : {ipm, mprgp})
+  for (const SolverParameters &prm : {ipm, mprgp, apgd})
     {
       std::vector<SolveReport> reports;
       const Eigen::VectorXd    v = velocities_after(s, ContactLaw{}, prm, 3, &reports);
@@ -213,7 +217,7 @@ TEST(ContactSolvers, GlobalMethodsWithTheWallAsLowRankMatchConvergedNlgs)
       for (const auto &r : reports)
         {
           EXPECT_LT(r.law_residual, 1e-7) << method_name(prm.method);
-          if (prm.method == SolverParameters::Method::mprgp) // the interior point stops at its floor
+          if (prm.method != SolverParameters::Method::interior_point) // it stops at its floor
             {
               EXPECT_TRUE(r.converged) << method_name(prm.method);
             }
@@ -269,7 +273,7 @@ TEST(ContactSolvers, GlobalMethodsCarryTheAppliedForceOfADiscOnAWall)
         {
           EXPECT_TRUE(report.solver.converged) << name;
         }
-      if (prm.method == SolverParameters::Method::mprgp)
+      if (prm.method == SolverParameters::Method::mprgp || prm.method == SolverParameters::Method::apgd)
         {
           EXPECT_GE(report.solver.iterations, 1u);
         }
@@ -360,9 +364,9 @@ TEST(ContactSolvers, GlobalMethodsWithElasMatchConvergedNlgs)
         }
     }
   EXPECT_LE(fallbacks, 10u);
-  // MPRGP and the interior-point method: the compliance makes A better conditioned; they
+  // MPRGP, APGD and the interior-point method: the compliance makes A better conditioned; they
   // have no fallback and need none.
-  for (const SolverParameters &prm : {global_methods()[1], global_methods()[2]})
+  for (const SolverParameters &prm : {global_methods()[1], global_methods()[2], global_methods()[3]})
     {
       reports.clear();
       const Eigen::VectorXd v = velocities_after(s, law, prm, 30, &reports);

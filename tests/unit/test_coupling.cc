@@ -95,8 +95,8 @@ TEST(Coupling, ElasticBlockOnGrainsCarriesThePressureAndBalancesEnergy)
 TEST(Coupling, GlobalContactSolversMatchConvergedNlgsAgainstTheElasticBlock)
 {
   // The half-disc contacts couple through the block's condensed compliance (dense
-  // blocks of the sparse Delassus operator): the active set, MPRGP and the interior-point
-  // method, asked for a law residual of 1e-11, give NLGS's history (converged to 1e-12) while the wall under the
+  // blocks of the sparse Delassus operator): the active set, MPRGP, APGD and the
+  // interior-point method, asked for a law residual of 1e-11, give NLGS's history (converged to 1e-12) while the wall under the
   // grains slides at 1 m/s and the block takes its load: the wall's reaction, the grains'
   // kinetic energy and the block's energy at every step.
   using History = std::vector<std::array<double, 3>>;
@@ -130,7 +130,7 @@ TEST(Coupling, GlobalContactSolversMatchConvergedNlgsAgainstTheElasticBlock)
   ASSERT_GT(scale[0], 0.5 * P * L);
   ASSERT_GT(scale[1], 0.0);
   for (const auto method : {dem::SolverParameters::Method::active_set, dem::SolverParameters::Method::mprgp,
-                            dem::SolverParameters::Method::interior_point})
+                            dem::SolverParameters::Method::interior_point, dem::SolverParameters::Method::apgd})
     {
       dem::SolverParameters prm = nlgs;
       prm.method                = method;
