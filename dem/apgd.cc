@@ -34,7 +34,7 @@ namespace tribo::dem
       }
     };
 
-    /// Momentum iterations of the power method from a fixed start: an estimate (from below)
+    /// Iterations of the power method from a fixed start: an estimate (from below)
     /// of the largest eigenvalue of the operator.
     constexpr int power_iterations = 10;
     /// The estimate's safety factor.
