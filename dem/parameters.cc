@@ -102,7 +102,7 @@ namespace tribo::dem
     prm.declare_entry("Relaxation", "1", Double(), "Relaxation omega in (0, 1]: r = omega r_law + (1 - omega) r_old.");
     prm.declare_entry("Check interval", "10", Integer(1), "Sweeps between convergence checks, >= 1.");
     prm.declare_entry("Maximum iterations", "10000", Integer(1),
-                      "Maximum number of sweeps per step (MPRGP: products with the Delassus "
+                      "Maximum number of sweeps per step (MPRGP, APGD: products with the Delassus "
                       "operator), >= 1.");
     prm.declare_entry("Contact order", "fixed", Selection("fixed|alternating|random"),
                       "Order of the local solves: 'fixed' (detection order: cells by rows, bottom to "
