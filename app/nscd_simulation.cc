@@ -136,6 +136,14 @@ namespace tribo::app
                   << " s (step " << start << "; its sample_final.csv, without contact impulses)";
             log(state.str());
           }
+        if (!p.solver.unused_nlgs_entries.empty() && p.law.friction <= 0)
+          {
+            std::ostringstream unused;
+            unused << "Solver/Method = " << dem::method_name(p.solver.method) << " stops at Solver/Residual target = "
+                   << p.solver.residual_target << "; the NLGS entries " << p.solver.unused_nlgs_entries
+                   << " have no effect on this frictionless case (they act with Method = nlgs)";
+            log(unused.str());
+          }
         if (p.solver.method != dem::SolverParameters::Method::nlgs && p.law.friction > 0)
           log("Solver/Method = " + dem::method_name(p.solver.method) +
               " solves frictionless problems only: with Coulomb friction (mu = " +

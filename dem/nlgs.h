@@ -49,7 +49,11 @@ namespace tribo::dem
       interior_point,
       apgd
     };
-    Method method = Method::nlgs;
+    Method method = Method::nlgs; ///< (a case file's default is apgd: dem/parameters.cc)
+    /// NLGS's stopping entries (Tolerance, Norm, Check interval) a case file set although
+    /// the method is another, with where they were set ("Solver/Tolerance (case.prm:24)"):
+    /// they then act only on the steps NLGS solves (friction), and the run log says so.
+    std::string unused_nlgs_entries;
     /// Active set: relative regularisation delta of the Newton matrix W_FF + delta
     /// diag(W_FF) (redundant, hyperstatic contacts make W_FF singular; it changes the step,
     /// not the solution).

@@ -65,18 +65,17 @@ namespace tribo::dem
 
   void SolverParameters::declare(dealii::ParameterHandler &prm)
   {
-    prm.declare_entry("Method", "nlgs", Selection("nlgs|active-set|mprgp|interior-point|apgd"),
-                      "Contact solver: 'nlgs' (nonlinear Gauss-Seidel, the entries below), "
-                      "'active-set' (projected Newton method on the frictionless problem, the "
-                      "sparse Delassus operator factorised by CHOLMOD) or 'mprgp' (matrix-free "
-                      "projected conjugate gradient with proportioning, on both cores with "
-                      "Threads = 2) or 'interior-point' (Mehrotra's predictor-corrector, CHOLMOD: "
-                      "the one that reaches 1e-8 on dense packings) or 'apgd' (matrix-free "
-                      "accelerated projected gradient with restart, both cores with Threads = 2: "
-                      "the fastest measured at residuals of 1e-3 and 1e-4, docs/performance.md). The "
-                      "last four stop at "
-                      "Residual target; with friction their steps use NLGS and the log says so. "
-                      "docs/performance.md compares them.");
+    prm.declare_entry("Method", "apgd", Selection("nlgs|active-set|mprgp|interior-point|apgd"),
+                      "Contact solver: 'apgd' (the default: matrix-free accelerated projected "
+                      "gradient with restart, both cores with Threads = 2; the fastest measured at "
+                      "residuals of 1e-3 to 7e-3, on the main job and the established code's sample, "
+                      "docs/performance.md), 'nlgs' (nonlinear Gauss-Seidel, the entries Tolerance to "
+                      "Streams below), 'active-set' (projected Newton method on the frictionless "
+                      "problem, the sparse Delassus operator factorised by CHOLMOD), 'mprgp' "
+                      "(matrix-free projected conjugate gradient with proportioning) or "
+                      "'interior-point' (Mehrotra's predictor-corrector, CHOLMOD: the one that "
+                      "reaches 1e-8 on dense packings). All but nlgs stop at Residual target; with "
+                      "friction their steps use NLGS and the log says so.");
     prm.declare_entry("Residual target", "1e-3", Double(),
                       "Active set, MPRGP, interior point, APGD: the solve ends when the law residual, max over "
                       "contacts of |min(r~, u~ / W_nn)| over the mean loaded impulse r~ "
@@ -162,6 +161,11 @@ namespace tribo::dem
                                  " (bands solved at once need the fixed order)");
     p.relative_gap_tolerance =
       f.get_checked(entry("Gap tolerance"), non_negative, "a fraction >= 0 of the smallest radius");
+    if (p.method != Method::nlgs)
+      for (const char *name : {"Tolerance", "Norm", "Check interval"})
+        if (!f.is_default(entry(name)))
+          p.unused_nlgs_entries += std::string(p.unused_nlgs_entries.empty() ? "" : ", ") + entry(name) +
+                                   " (" + f.where(entry(name)) + ")";
     return p;
   }
 } // namespace tribo::dem

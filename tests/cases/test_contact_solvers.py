@@ -53,7 +53,7 @@ class MprgpAgainstNlgs(unittest.TestCase):
         cls.tmp = tempfile.TemporaryDirectory()
         nlgs_dir = os.path.join(cls.tmp.name, "nlgs")
         os.makedirs(nlgs_dir)
-        cls.nlgs, nlgs_rows = run(nlgs_dir)
+        cls.nlgs, nlgs_rows = run(nlgs_dir, "Solver/Method=nlgs")
         shear = [r["law_residual"] for r in nlgs_rows if r["time"] >= SHEAR_START]
         cls.target = float(np.mean(shear))
         mprgp_dir = os.path.join(cls.tmp.name, "mprgp")
