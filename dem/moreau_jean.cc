@@ -392,12 +392,11 @@ namespace tribo::dem
           for (unsigned int i = 0; i < boundary->n_nodes(); ++i)
             fastest_node = std::max(fastest_node, boundary->node_velocity(i).norm());
         const double speed = std::max(fastest.first, fastest_node);
+        const bool         by_nlgs = !global_method() || report.solver.fell_back;
         std::ostringstream os;
         os << "an overlap of " << deepest_overlap << " m, more than the smallest disc radius ("
            << r_min << " m): contacts were missed or left unresolved ("
-           << method_name(global_method() && !report.solver.fell_back ? solver.parameters().method
-                                                                      : SolverParameters::Method::nlgs)
-           << " " << (report.solver.converged ? "converged" : "not converged") << "). ";
+           << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver.parameters().method) << " " << (report.solver.converged ? "converged" : "not converged") << "). ";
         if (speed * h > 0.25 * r_min)
           os << "The fastest mover, "
              << (fastest.first >= fastest_node ? "body " + std::to_string(fastest.second)
@@ -411,7 +410,8 @@ namespace tribo::dem
                   "overlap does not come from the step size. Either discs were placed overlapping, "
                   "or the law lets it grow: with IQS, overlaps kept step after step within the "
                   "solver's tolerance (high pressure: tighten "
-               << solver_section.entry("Tolerance") << " or " << solver_section.entry("Gap tolerance")
+               << (by_nlgs ? solver_section.entry("Tolerance") + " or " + solver_section.entry("Gap tolerance")
+                           : solver_section.entry("Residual target"))
                << ", or set " << contact_law.section.entry("Overlap recovery")
                << "); with ELAS, a stiffness too low for the load (docs/laws.md)";
           }

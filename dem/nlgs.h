@@ -50,7 +50,7 @@ namespace tribo::dem
       apgd
     };
     Method method = Method::nlgs; ///< (a case file's default is apgd: dem/parameters.cc)
-    /// NLGS's stopping entries (Tolerance, Norm, Check interval) a case file set although
+    /// NLGS's stopping entries (Tolerance, Norm, Check interval, Gap tolerance) a case file set although
     /// the method is another, with where they were set ("Solver/Tolerance (case.prm:24)"):
     /// they then act only on the steps NLGS solves (friction), and the run log says so.
     std::string unused_nlgs_entries;

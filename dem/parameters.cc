@@ -122,7 +122,7 @@ namespace tribo::dem
                       "same result on any number of cores. Needs Contact order = fixed. The contact "
                       "detection also runs in T threads (the same contacts whatever T).");
     prm.declare_entry("Gap tolerance", "0", Double(),
-                      "Extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
+                      "NLGS: extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
                       "0: off, the established code's norms only): every contact's gap violation "
                       "theta h max(0, -(u_n + shift)) must be below it. Limits the overlaps that the "
                       "norms let accumulate under high pressure, at the price of more sweeps.");
@@ -162,7 +162,7 @@ namespace tribo::dem
     p.relative_gap_tolerance =
       f.get_checked(entry("Gap tolerance"), non_negative, "a fraction >= 0 of the smallest radius");
     if (p.method != Method::nlgs)
-      for (const char *name : {"Tolerance", "Norm", "Check interval"})
+      for (const char *name : {"Tolerance", "Norm", "Check interval", "Gap tolerance"})
         if (!f.is_default(entry(name)))
           p.unused_nlgs_entries += std::string(p.unused_nlgs_entries.empty() ? "" : ", ") + entry(name) +
                                    " (" + f.where(entry(name)) + ")";
