@@ -396,7 +396,8 @@ namespace tribo::dem
         std::ostringstream os;
         os << "an overlap of " << deepest_overlap << " m, more than the smallest disc radius ("
            << r_min << " m): contacts were missed or left unresolved ("
-           << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver.parameters().method) << " " << (report.solver.converged ? "converged" : "not converged") << "). ";
+           << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver.parameters().method) << " "
+           << (report.solver.converged ? "converged" : "not converged") << "). ";
         if (speed * h > 0.25 * r_min)
           os << "The fastest mover, "
              << (fastest.first >= fastest_node ? "body " + std::to_string(fastest.second)

@@ -277,26 +277,22 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   SolverParameters solver = tight();
   law.section             = {"Contact law"};
   solver.section          = {"Solver"};
+  // The message for a step solved by @p method, whose accuracy entries are @p advice.
+  auto placed_overlap = [](const std::string &method, const std::string &advice) {
+    return "an overlap of 7e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
+           "missed or left unresolved (" + method + " converged). No body moved more than a quarter of "
+           "the smallest radius in the step: the overlap does not come from the step size. "
+           "Either discs were placed overlapping, or the law lets it grow: with IQS, overlaps "
+           "kept step after step within the solver's tolerance (high pressure: tighten " + advice +
+           ", or set Contact law/Overlap recovery); with ELAS, a stiffness too low for the load "
+           "(docs/laws.md)";
+  };
   MoreauJean mj(0.5, law, solver, 1e-8);
-  EXPECT_EQ(step_error(mj, placed, 1e-8),
-            "an overlap of 7e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
-            "missed or left unresolved (nlgs converged). No body moved more than a quarter of "
-            "the smallest radius in the step: the overlap does not come from the step size. "
-            "Either discs were placed overlapping, or the law lets it grow: with IQS, overlaps "
-            "kept step after step within the solver's tolerance (high pressure: tighten "
-            "Solver/Tolerance or Solver/Gap tolerance, or set Contact law/Overlap recovery); with "
-            "ELAS, a stiffness too low for the load (docs/laws.md)");
+  EXPECT_EQ(step_error(mj, placed, 1e-8), placed_overlap("nlgs", "Solver/Tolerance or Solver/Gap tolerance"));
   // Solved by APGD, the advice names its accuracy entry instead of NLGS's.
   solver.method = SolverParameters::Method::apgd;
   MoreauJean by_apgd(0.5, law, solver, 1e-8);
-  EXPECT_EQ(step_error(by_apgd, placed, 1e-8),
-            "an overlap of 7e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
-            "missed or left unresolved (apgd converged). No body moved more than a quarter of "
-            "the smallest radius in the step: the overlap does not come from the step size. "
-            "Either discs were placed overlapping, or the law lets it grow: with IQS, overlaps "
-            "kept step after step within the solver's tolerance (high pressure: tighten "
-            "Solver/Residual target, or set Contact law/Overlap recovery); with "
-            "ELAS, a stiffness too low for the load (docs/laws.md)");
+  EXPECT_EQ(step_error(by_apgd, placed, 1e-8), placed_overlap("apgd", "Solver/Residual target"));
   // Closing at 200 m/s from a gap of 0.1 um in steps of 1e-8 s (2 um per step): the
   // pair is detected and stopped, but the explicit half step (1 - theta) h v carries it
   // 1 um into the overlap.
