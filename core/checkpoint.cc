@@ -17,8 +17,9 @@ namespace tribo
   {
     /// First entry of every checkpoint: what it is and its layout version (2: the wall time
     /// follows the parameters, and the SPH and MLP scenes checkpoint; 3: the SPH solver
-    /// carries its viscous heat).
-    const std::string magic = "tribo checkpoint 3";
+    /// carries its viscous heat; 4: a particle first body carries its chain's mean
+    /// velocity over the last step).
+    const std::string magic = "tribo checkpoint 4";
   } // namespace
 
   void write_checkpoint(const std::string &path, const std::function<void(CheckpointOut &)> &save)

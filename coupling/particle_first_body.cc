@@ -26,6 +26,7 @@ namespace tribo::coupling
     free.assign(n, dem::Vec2::Zero());
     begin_velocity.assign(n, dem::Vec2::Zero());
     end_velocity.assign(n, dem::Vec2::Zero());
+    mean_velocity.assign(n, dem::Vec2::Zero());
     for (unsigned int i = 0; i < n; ++i)
       {
         reference_x[i] = position(chain[i]).x();
@@ -112,10 +113,7 @@ namespace tribo::coupling
   {
     const unsigned int n = chain.size();
     for (unsigned int i = 0; i < n; ++i)
-      {
-        start[i]          = unwrapped(i);
-        begin_velocity[i] = velocity(chain[i]);
-      }
+      start[i] = unwrapped(i);
     top_start_y.resize(top.size());
     for (std::size_t q = 0; q < top.size(); ++q)
       top_start_y[q] = position(top[q]).y();
@@ -127,9 +125,13 @@ namespace tribo::coupling
     substeps          = advance(h, step_load, std::vector<dem::Vec2>(n, dem::Vec2::Zero()));
     free_displacement = chain_displacement();
     engine_free       = true;
-    const double th   = prm.theta;
+    // v_b: the chain's mean velocity over the last step (file comment).
+    const double th = prm.theta;
     for (unsigned int i = 0; i < n; ++i)
-      free[i] = (free_displacement.segment<2>(2 * i) / h - (1 - th) * begin_velocity[i]) / th;
+      {
+        begin_velocity[i] = mean_velocity[i];
+        free[i] = (free_displacement.segment<2>(2 * i) / h - (1 - th) * begin_velocity[i]) / th;
+      }
     if (stale || h != compliance_h)
       build_compliance(h, step_load);
     in_step = true;
@@ -165,7 +167,8 @@ namespace tribo::coupling
     double                booked = 0;
     for (unsigned int i = 0; i < n; ++i)
       {
-        end_velocity[i] = (d.segment<2>(2 * i) / h - (1 - th) * begin_velocity[i]) / th;
+        end_velocity[i]  = (d.segment<2>(2 * i) / h - (1 - th) * begin_velocity[i]) / th;
+        mean_velocity[i] = d.segment<2>(2 * i) / h;
         booked += R.segment<2>(2 * i).dot(0.5 * (begin_velocity[i] + end_velocity[i]));
       }
     extra_work = R.dot(d) / h - booked;
@@ -240,8 +243,9 @@ namespace tribo::coupling
        << predicted_response_work;
     const std::vector<double> g(G.data(), G.data() + G.size());
     ar << g;
-    for (const dem::Vec2 &u : end_velocity)
-      ar << u.x() << u.y();
+    for (const std::vector<dem::Vec2> *v : {&end_velocity, &mean_velocity})
+      for (const dem::Vec2 &u : *v)
+        ar << u.x() << u.y();
   }
 
   void ParticleFirstBody::load(CheckpointIn &ar)
@@ -256,8 +260,9 @@ namespace tribo::coupling
       throw InputError("checkpoint: its particle-body compliance has " + std::to_string(g.size()) +
                        " entries, this case's chain needs " + std::to_string(G.size()));
     std::copy(g.begin(), g.end(), G.data());
-    for (dem::Vec2 &u : end_velocity)
-      ar >> u.x() >> u.y();
+    for (std::vector<dem::Vec2> *v : {&end_velocity, &mean_velocity})
+      for (dem::Vec2 &u : *v)
+        ar >> u.x() >> u.y();
     for (unsigned int i = 0; i < chain.size(); ++i)
       start[i] = unwrapped(i);
   }

@@ -17,9 +17,14 @@
 ///   G = sym(D) / (theta h) (-> diag(1 / m_i) when omega h -> 0, the lumped mass);
 /// - the velocities the solver sees are those that move the nodes as the Moreau-Jean
 ///   scheme moves a node, x_1 = x_0 + h ((1 - theta) v_b + theta u): begin velocity
-///   v_b = the chain particles' velocities at the start, free velocity
-///   u_free = (d_free / h - (1 - theta) v_b) / theta, so that u = u_free + G R gives
-///   the linearised end positions d_free + D R exactly;
+///   v_b = the chain's mean velocity over the last step, d_last / h, free velocity
+///   u_free = (d_free / h - (1 - theta) v_b) / theta, so that u = u_free + G R gives the
+///   linearised end positions d_free + D R exactly. Only displacements enter: the
+///   particles' instantaneous velocities, which a step of several wave crossings samples
+///   as noise, would reach the grains through u with the gain (1 - theta) / theta (one at
+///   theta = 1/2) and heat the chain; d_free / h as v_b would put every predicted contact
+///   as deep into overlap as the unsupported chain falls in half a step
+///   (docs/first_bodies.md, "Kinematics");
 /// - finalize(R): restore S_0 and advance the real nonlinear body with the forces
 ///   R_i / h on the chain (kept as is when every R_i = 0). The chain's end velocities
 ///   reported are u = (d / h - (1 - theta) v_b) / theta with the real displacements d.
@@ -139,6 +144,7 @@ namespace tribo::coupling
     std::vector<double>    reference_x;        ///< of the chain, increasing
     std::vector<dem::Vec2> start, free;        ///< chain start positions, free velocities
     std::vector<dem::Vec2> begin_velocity, end_velocity; ///< v_b, u (file comment)
+    std::vector<dem::Vec2> mean_velocity; ///< chain displacements of the last step / h, m/s
     std::vector<double>    top_start_y;        ///< top-row y at the start of the step, m
     Eigen::VectorXd        free_displacement;  ///< d_free, m
     Eigen::MatrixXd        G;
