@@ -18,7 +18,7 @@ namespace tribo
     /// First entry of every checkpoint: what it is and its layout version (2: the wall time
     /// follows the parameters, and the SPH and MLP scenes checkpoint; 3: the SPH solver
     /// carries its viscous heat; 4: a particle first body carries its chain's mean
-    /// velocity over the last step).
+    /// velocity over the last step, the shear scene its upper body's speed at Shear start).
     const std::string magic = "tribo checkpoint 4";
   } // namespace
 

@@ -114,6 +114,9 @@ namespace tribo::app
           if (b != lower && b != upper_body->system_body())
             ke_tb += s.bodies[b].kinetic_energy();
         const UpperState ub = upper_body->state(s, power);
+        if (sliding && std::isnan(vy_at_shear_start))
+          vy_at_shear_start = last_vy;
+        last_vy = ub.vy;
         const double gap = ub.y - s.bodies[lower].position.y();
         const double surface_gap = ub.surface - (s.bodies[lower].position.y() + 0.5 * lower_wall_diameter);
         if (surface_gap < 0)
@@ -167,6 +170,7 @@ namespace tribo::app
             start = steady.start;
             j.set("steady_state_reached", steady.reached);
             j.set("steady_state_start", steady.start);
+            j.set("upper_body_vy_at_shear_start", vy_at_shear_start);
           }
         else
           steady.start = t1 + 1; // no profile sample is in a steady state
@@ -194,6 +198,12 @@ namespace tribo::app
           if (sliding)
             note << "; " << profiles->n_samples_after(steady.start) << " profile samples of " << block_steps
                  << " steps each";
+          if (sliding && std::abs(vy_at_shear_start) > still_moving * std::abs(k.sliding_velocity))
+            note << ". At Shear start the upper body was still moving at " << vy_at_shear_start
+                 << " m/s (more than " << 100 * still_moving
+                 << " % of the sliding velocity): the layer had not finished compacting, and the shear "
+                    "began with the body landing on it; a later "
+                    "Shear cell/Shear start lets it settle";
           averaging = note.str();
         }
         upper_body->summarize(j);
@@ -289,7 +299,7 @@ namespace tribo::app
       {
         std::ostringstream random;
         random << rng;
-        ar << random.str() << steps_done << sliding << normal_force << block_steps;
+        ar << random.str() << steps_done << sliding << normal_force << block_steps << last_vy << vy_at_shear_start;
         profiles->save(ar);
         upper_body->save(ar);
       }
@@ -297,7 +307,7 @@ namespace tribo::app
       void load(CheckpointIn &ar) override
       {
         std::string random;
-        ar >> random >> steps_done >> sliding >> normal_force >> block_steps;
+        ar >> random >> steps_done >> sliding >> normal_force >> block_steps >> last_vy >> vy_at_shear_start;
         std::istringstream is(random);
         is >> rng;
         profiles->load(ar);
@@ -477,6 +487,12 @@ namespace tribo::app
       unsigned long                  block_steps = 0;
       bool                           sliding    = false; ///< the lower wall has started sliding
       double                         normal_force = 0;   ///< P L at the current ramp, N/m
+      /// The upper body's vertical velocity after the last step, and after the last step
+      /// before the shear (NaN until the shear starts), m/s.
+      double                         last_vy = 0, vy_at_shear_start = NAN;
+      /// A body faster than this fraction of the sliding velocity at Shear start has not
+      /// landed (the default case's at 10 us: 1.04 m/s, landed at 16 us: 0.015 m/s).
+      static constexpr double        still_moving = 0.01;
       double                         lower_wall_diameter = 0, mean_grain_diameter = 0;
       std::unique_ptr<UpperBody>     upper_body; ///< rigid wall or deformable body
       std::unique_ptr<LayerProfiles> profiles;

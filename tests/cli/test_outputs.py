@@ -342,7 +342,8 @@ COMPACTION_RESULTS = ["sliding", "averaging_start", "normal_force_mean", "normal
                       "normal_force_target", "third_body_thickness", "third_body_thickness_stderr",
                       "solid_fraction_mean", "solid_fraction_stderr", "face_shift_mean", "face_shift_stderr",
                       "face_shift_max", "face_shift_in_half_discs", "cohesion_number"]
-SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "averaging_start",
+SLIDING_RESULTS = ["sliding", "steady_state_reached", "steady_state_start", "upper_body_vy_at_shear_start",
+                   "averaging_start",
                    "normal_force_mean", "normal_force_stderr", "normal_force_target",
                    "third_body_thickness", "third_body_thickness_stderr", "solid_fraction_mean",
                    "solid_fraction_stderr", "face_shift_mean", "face_shift_stderr", "face_shift_max",
@@ -668,6 +669,23 @@ class Sliding(ShearRun, unittest.TestCase):
         ke_lower = self.imposed_kinetic_energy()
         np.testing.assert_allclose(ke_lower[sliding], 0.5 * m_lower * self.V ** 2, rtol=1e-6)
         np.testing.assert_allclose(ke_lower[~sliding], 0, atol=1e-12 * ke_lower.max())
+
+    def test_upper_body_speed_at_shear_start(self):
+        """upper_body_vy_at_shear_start is upper_wall_vy after the last step before Shear
+        start; above 1 % of V the log's averaging line says the body had not landed."""
+        r, st = self.summary["results"], self.stats
+        last_before = st["step"] == round(self.SHEAR_START / self.H)
+        vy = st["upper_wall_vy"][last_before][0]
+        self.assertEqual(r["upper_body_vy_at_shear_start"], vy)
+        with open(os.path.join(self.out, "log.txt")) as f:
+            log = f.read()
+        note = ("At Shear start the upper body was still moving at %g m/s (more than 1 %% of the sliding "
+                "velocity): the layer had not finished compacting" % vy)
+        if abs(vy) > 0.01 * self.V:
+            self.assertIn(note, log)
+        else:
+            self.assertNotIn("At Shear start the upper body was still moving", log)
+        print(f"upper body at Shear start: {vy:.4g} m/s")
 
     def test_mu(self):
         """mu = -F_x / normal_force, F_x the x contact force on the lower wall, whose
