@@ -7,7 +7,8 @@ test_shear_physics.py (120 discs, 13 us of shear, tolerance 1e-3):
   h (power_external + power_contacts - power_damping_upper_body), the damping being the
   compaction damping, gone after Shear start;
 - equilibrium: the mean normal force on the lower wall is P L, and the time-averaged
-  sigma_yy profile is flat at P away from the first bodies;
+  sigma_yy profile is flat at P away from the first bodies; the power books close, and
+  a body that had landed at Shear start dissipates what the lower wall puts in;
 - the stiff limit: a body 1e6 times stiffer than steel, with half-discs as large as the
   rigid wall's discs (the same roughness), gives the rigid wall's friction and a
   velocity profile that ends near 0 at the upper body, as the rigid wall does. A cell of
@@ -104,7 +105,14 @@ class DeformableUpperBody(unittest.TestCase):
             self.assertAlmostEqual(r["normal_force_mean"] / (P * L), 1.0, delta=0.01)
             interior = p["sigma_yy"][2:-2]
             np.testing.assert_allclose(interior, P, rtol=0.03)
-            self.assertAlmostEqual(r["power_balance_ratio"], 1.0, delta=0.05)
+            # The books close whatever the body does; dissipation equals the lower wall's
+            # power only once the body has landed. At Shear start (3 us) the steel and
+            # reduced bodies still descend at 0.94 m/s, and a window that starts while they
+            # land also dissipates the energy they bring: dissipated / lower-wall power
+            # 1.16 for the reduced body on one machine's trajectory (closure 0.9995).
+            self.assertAlmostEqual(r["power_balance_closure"], 1.0, delta=0.01)
+            if abs(r["upper_body_vy_at_shear_start"]) < 0.01 * V:
+                self.assertAlmostEqual(r["power_balance_ratio"], 1.0, delta=0.05)
 
     def test_stiff_body_reproduces_the_rigid_wall(self):
         mu = {name: np.mean([r["mu_mean"] for _, r, _, _ in runs])
