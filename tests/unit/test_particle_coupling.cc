@@ -65,7 +65,9 @@ namespace
   /// grains from above. Step @p h, load ramped over 20 ns, compaction damping (zeta = 1)
   /// until 0.3 us, then @p steps steps in all; from 0.3 us the wall moves along x at
   /// @p wall_speed (m/s), dragging the grains in its pockets under the frictionless chain.
-  ColumnRun run_column(const std::string &model, double h, unsigned int steps, double wall_speed = 0)
+  /// NLGS to @p tolerance, checked every sweep.
+  ColumnRun run_column(const std::string &model, double h, unsigned int steps, double wall_speed = 0,
+                       double tolerance = 1e-8)
   {
     dem::ParticleSystem sys;
     sys.period = L;
@@ -85,7 +87,7 @@ namespace
     auto body = coupling::make_first_body(column_body(model, h, y_grain + s));
 
     dem::SolverParameters nlgs;
-    nlgs.tolerance = 1e-8;
+    nlgs.tolerance = tolerance;
     nlgs.check_interval = 1;
     dem::MoreauJean mj(0.5, dem::ContactLaw{}, nlgs, 0.05 * s);
     mj.attach(*body, s, {0, -1}, L);
@@ -246,13 +248,15 @@ TEST(ParticleCoupling, MlpBodyOnGrainsKeepsItsThicknessAtFourWaveCrossingsPerSte
 TEST(ParticleCoupling, MlpBodyOverShearedGrainsAtEightWaveCrossingsIsAsQuietAsAtTwo)
 {
   // The wall drags its grains at 5 m/s under the chain from 0.3 us. The body's kinetic
-  // energy over the last third must not depend on the step (measured 2026-11-26: 4.4e-6
-  // J/m at c_p h / s = 1, 4.0e-6 at 2, 5.5e-6 at 8). The chain kinematics that took the
-  // particles' real start velocities as v_b (until 2026-11-26) fed their vibration back
-  // into the grains with gain one at theta = 1/2: 5.9e-5 J/m at 2, 3.1e-4 at 8
-  // (docs/first_bodies.md, "Kinematics").
-  const ColumnRun reference = run_column("mlp", step_for(2), 6000, 5.0);
-  const ColumnRun long_step = run_column("mlp", step_for(8), 1500, 5.0);
+  // energy over the last third must not depend on the step (measured 2026-11-26 with NLGS
+  // to 1e-8: 4.4e-6 J/m at c_p h / s = 1, 4.0e-6 at 2, 5.5e-6 at 8; to 1e-5, as here:
+  // 3.7e-6 at 2, 5.5e-6 at 8). The chain kinematics that took the particles' real start
+  // velocities as v_b (until 2026-11-26) fed their vibration back into the grains with
+  // gain one at theta = 1/2: 5.9e-5 J/m at 2, 3.1e-4 at 8 (docs/first_bodies.md,
+  // "Kinematics"). NLGS to 1e-5: with the grains sliding under the chain, 1e-8 costs a
+  // minute.
+  const ColumnRun reference = run_column("mlp", step_for(2), 6000, 5.0, 1e-5);
+  const ColumnRun long_step = run_column("mlp", step_for(8), 1500, 5.0, 1e-5);
   EXPECT_LT(long_step.body_kinetic, 2 * reference.body_kinetic);
   EXPECT_GT(long_step.body_kinetic, 0.5 * reference.body_kinetic);
   expect_column_holds(long_step);
