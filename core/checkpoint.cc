@@ -10,6 +10,8 @@
 
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
+#include <new>
 
 namespace tribo
 {
@@ -61,6 +63,17 @@ namespace tribo
       {
         throw InputError("checkpoint " + path + ": unreadable (" + std::string(e.what()) +
                          "); it was written by another build or for another case");
+      }
+    catch (const std::length_error &)
+      {
+        // A count read from the wrong place (another build's layout) sized a container.
+        throw InputError("checkpoint " + path + ": unreadable (a size out of range); it was "
+                         "written by another build or for another case");
+      }
+    catch (const std::bad_alloc &)
+      {
+        throw InputError("checkpoint " + path + ": unreadable (a size too large to allocate); it was "
+                         "written by another build or for another case");
       }
   }
 } // namespace tribo

@@ -6,14 +6,15 @@
 - the same with the deal.II upper body, stopped by SIGTERM (which writes a checkpoint
   of the last step done) instead of SIGKILL;
 - a resumed run may change Solver/*, Output/* and End time (logged), nothing else:
-  exact error messages for another entry, for a directory without a checkpoint and for
-  a complete run (whose checkpoint is removed).
+  exact error messages for another entry, for a damaged checkpoint, for a directory
+  without a checkpoint and for a complete run (whose checkpoint is removed).
 
 Usage: /usr/bin/python3 test_resume.py /path/to/tribo
 """
 
 import filecmp
 import os
+import shutil
 import signal
 import sys
 
@@ -107,6 +108,19 @@ class Resume(TempDirTestCase):
                          "and Simulation/End time")
         self.assertEqual(read_json(os.path.join(self.tmp, "out", "summary.json"))["status"], "interrupted",
                          "a refused resumption leaves the run as it was")
+        # A checkpoint whose first count after the header is 2^60 (another build's layout,
+        # or a damaged file): a clear error, not the allocator's.
+        shutil.copytree(os.path.join(self.tmp, "out"), os.path.join(self.tmp, "damaged"))
+        path = os.path.join(self.tmp, "damaged", "checkpoint.bin")
+        with open(path, "rb") as f:
+            data = f.read()
+        at = data.index(b"tribo checkpoint ") + len(b"tribo checkpoint 4")
+        with open(path, "wb") as f:
+            f.write(data[:at] + (1 << 60).to_bytes(8, "little") + data[at + 8:])
+        r = run(["run", "case.prm", "--resume", "damaged", "--quiet"], self.tmp)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertRegex(r.stderr.strip(), r"^error: checkpoint \S*damaged/checkpoint.bin: unreadable \(.+\); it "
+                                           r"was written by another build or for another case$")
         self.run_ok(["run", "case.prm", "--resume", "out", "--quiet", "--set", "Solver/Tolerance=5e-4",
                      "--set", "Simulation/End time=2.2e-6"])
         s = read_json(os.path.join(self.tmp, "out", "summary.json"))
