@@ -9,9 +9,9 @@
 #include <boost/serialization/string.hpp>
 
 #include <fstream>
+#include <new>
 #include <sstream>
 #include <stdexcept>
-#include <new>
 
 namespace tribo
 {
