@@ -21,7 +21,15 @@
 ///   mean impulse: K dc = t / y with t pulling the products (y + a~ dy)_i (s + a~ ds)_i at
 ///   a longer trial step a~ = min(1, 1.5 alpha + 0.1) back into [0.1, 10] sigma mu; dy + dc
 ///   is kept while it lengthens the step (15 % fewer factorisations, docs/performance.md);
-/// - step: 0.995 of the largest step that keeps y, s > 0, the same for both.
+/// - step: 0.995 of the largest step that keeps y, s > 0, the same for both;
+/// - crossover (since 2026-11-26, fifth session): once the natural map is below 1e-4 of the
+///   mean impulse and the closed set C = {y_i > g_i} changed by at most 3 contacts in an
+///   iteration, the impulses that close C exactly, z = y + d, (A' + U U^T)_CC d = -g_C with
+///   d the least-norm correction (conjugate gradients from zero, preconditioned by the
+///   factorised A'_CC + 1e-8 I), contacts whose z_i < 0 opened; accepted when z meets the
+///   target and its mean impulse is within 1.5 times the warm start's (the iterate's
+///   component along the redundant directions must not be frozen and inflated step after
+///   step); otherwise the iteration goes on (at most 3 attempts, one factorisation each).
 /// Start: y_0 = max(warm start, nu), s_0 = max(A'y_0 + b', nu), nu a hundredth of the
 /// larger of the mean warm-started impulse and the mean |b'| (scaled). The iterate with the
 /// smallest natural map is applied, its open contacts (y_i <= g_i) at zero impulse. It stops at the natural-map test of the other global

@@ -393,3 +393,24 @@ TEST(ContactSolvers, GlobalMethodsWithFrictionUseNlgs)
         }
     }
 }
+
+TEST(ContactSolvers, InteriorPointReachesATightTargetAtEveryWarmStartedStepOfAHyperstaticStack)
+{
+  // Each warm-started step ends at the target, whether the iteration gets there or the
+  // crossover closes the closed set exactly (dem/interior_point.cc), and the velocities
+  // are converged NLGS's: a crossover that froze a growing component along the redundant
+  // directions would break both within a few steps.
+  SolverParameters prm;
+  prm.method          = SolverParameters::Method::interior_point;
+  prm.residual_target = 1e-10;
+  std::vector<SolveReport> reports;
+  const ParticleSystem     stack  = hexagonal_stack(400, 2);
+  const Eigen::VectorXd    v      = velocities_after(stack, ContactLaw{}, prm, 40, &reports);
+  const Eigen::VectorXd    v_nlgs = velocities_after(stack, ContactLaw{}, nlgs_converged(), 40);
+  EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
+  for (std::size_t step = 1; step < reports.size(); ++step)
+    {
+      EXPECT_TRUE(reports[step].converged) << "step " << step;
+      EXPECT_LT(reports[step].law_residual, 1e-10) << "step " << step;
+    }
+}
