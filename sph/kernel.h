@@ -1,7 +1,10 @@
 #pragma once
-/// @file Cubic-spline (M4) SPH kernel of Monaghan and Lattanzio (1985).
+/// @file Cubic-spline (M4) SPH kernel of Monaghan and Lattanzio (1985). Defined inline: the
+/// force loop calls the gradient once per pair (out of line it was 28 % of an SPH body's time).
 
 #include <deal.II/base/tensor.h>
+
+#include <cmath>
 
 namespace tribo::sph
 {
@@ -33,4 +36,48 @@ namespace tribo::sph
     /// Support radius 2h, m.
     static double support(double h) { return 2 * h; }
   };
+
+  template <int dim>
+  inline double CubicSplineKernel<dim>::normalisation(double h)
+  {
+    if constexpr (dim == 2)
+      return 10.0 / (7.0 * M_PI * h * h);
+    else
+      return 1.0 / (M_PI * h * h * h);
+  }
+
+  template <int dim>
+  inline double CubicSplineKernel<dim>::value(double r, double h)
+  {
+    const double q = r / h;
+    if (q >= 2)
+      return 0;
+    const double s = normalisation(h);
+    if (q < 1)
+      return s * (1 - 1.5 * q * q + 0.75 * q * q * q);
+    const double t = 2 - q;
+    return s * 0.25 * t * t * t;
+  }
+
+  template <int dim>
+  inline double CubicSplineKernel<dim>::derivative(double r, double h)
+  {
+    const double q = r / h;
+    if (q >= 2)
+      return 0;
+    const double s = normalisation(h) / h;
+    if (q < 1)
+      return s * (-3 * q + 2.25 * q * q);
+    const double t = 2 - q;
+    return -s * 0.75 * t * t;
+  }
+
+  template <int dim>
+  inline Tensor<1, dim> CubicSplineKernel<dim>::gradient(const Tensor<1, dim> &rij, double h)
+  {
+    const double r = rij.norm();
+    if (r <= 0 || r >= 2 * h)
+      return Tensor<1, dim>();
+    return (derivative(r, h) / r) * rij;
+  }
 } // namespace tribo::sph
