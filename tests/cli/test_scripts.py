@@ -1,0 +1,75 @@
+"""The analysis scripts of scripts/ on files whose answer is known."""
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+from tribo_cli import TempDirTestCase, main, read_png
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCRIPTS = os.path.join(HERE, "..", "..", "scripts")
+COLUMNS = ("vx", "solid_fraction", "sigma_xy", "granular_temperature")
+
+
+def write_profiles(directory, layers, shifts=None, stderr=0.1):
+    """A profiles.csv of @p layers layers: every column 1 + shift (shifts: {column: {layer:
+    value}}), every standard error @p stderr."""
+    os.makedirs(directory)
+    names = ["layer", "y_over_h"] + list(COLUMNS) + [c + "_stderr" for c in COLUMNS]
+    with open(os.path.join(directory, "profiles.csv"), "w") as f:
+        f.write(",".join(names) + "\n")
+        for i in range(layers):
+            values = [i, (i + 0.5) / layers]
+            values += [1 + (shifts or {}).get(c, {}).get(i, 0.0) for c in COLUMNS]
+            values += [stderr] * len(COLUMNS)
+            f.write(",".join(repr(float(v)) for v in values) + "\n")
+
+
+def compare_profiles(*args):
+    return subprocess.run([sys.executable, os.path.join(SCRIPTS, "compare_profiles.py")] + list(args),
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, timeout=120)
+
+
+class CompareProfiles(TempDirTestCase):
+    def test_differences_in_combined_standard_errors(self):
+        a, b = os.path.join(self.tmp, "a"), os.path.join(self.tmp, "b")
+        write_profiles(a, 5)
+        # vx: layer 2 higher by 0.3 and layer 4 lower by 0.1, against a combined error of
+        # sqrt(2) 0.1: z = 2.121 and -0.707; the other columns equal.
+        write_profiles(b, 5, {"vx": {2: 0.3, 4: -0.1}})
+        png = os.path.join(self.tmp, "overlay.png")
+        r = compare_profiles(a, b, "--labels", "A,B", "--plot", png)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = {line.split("|")[1].strip(): [cell.strip() for cell in line.split("|")[2:5]]
+                for line in r.stdout.splitlines() if line.startswith("| ") and not line.startswith("| column")}
+        self.assertEqual(rows["vx"], ["2.12", "1", "%+.2f" % ((2.1213 - 0.7071) / 5)])
+        for c in ("solid_fraction", "sigma_xy", "granular_temperature"):
+            self.assertEqual(rows[c], ["0.00", "0", "+0.00"])
+        self.assertIn("B against A, 5 layers", r.stdout)
+        image = read_png(self, png)
+        self.assertGreater(image.shape[1], image.shape[0])  # four panels side by side
+
+    def test_mismatched_layers_are_refused(self):
+        a, b = os.path.join(self.tmp, "a"), os.path.join(self.tmp, "b")
+        write_profiles(a, 5)
+        write_profiles(b, 4)
+        r = compare_profiles(a, b)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(os.path.join(b, "profiles.csv") + ": 4 layers, " + os.path.join(a, "profiles.csv") +
+                      " has 5: the runs must have the same layers", r.stderr)
+
+    def test_a_missing_column_is_named(self):
+        a, b = os.path.join(self.tmp, "a"), os.path.join(self.tmp, "b")
+        write_profiles(a, 3)
+        os.makedirs(b)
+        with open(os.path.join(b, "profiles.csv"), "w") as f:
+            f.write("layer,y_over_h,vx\n0,0.5,1.0\n")
+        r = compare_profiles(a, b)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(os.path.join(b, "profiles.csv") + ": expected the columns solid_fraction", r.stderr)
+
+
+if __name__ == "__main__":
+    main()
