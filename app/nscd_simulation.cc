@@ -306,6 +306,7 @@ namespace tribo::app
         os << steps_run << " steps in " << end.wall_time << " s, " << per_step(record.total_iterations)
            << (method == dem::SolverParameters::Method::mprgp  ? " NLGS sweeps and MPRGP products"
                : method == dem::SolverParameters::Method::apgd ? " NLGS sweeps and APGD products"
+               : method == dem::SolverParameters::Method::apgs ? " NLGS sweeps, APGS sweeps and products"
                                                                : " NLGS sweeps")
            << " per step, " << record.non_converged << " steps not converged, law residual mean "
            << per_step(record.sum_law_residual) << " max " << record.max_law_residual << ", worst overlap "

@@ -22,6 +22,7 @@ namespace tribo::dem
     , active_set(solver)
     , mprgp(solver)
     , apgd(solver)
+    , apgs(solver)
     , interior_point(solver)
     , predictor([&] {
       SolverParameters p = solver;
@@ -68,6 +69,8 @@ namespace tribo::dem
         SolveReport report = controls.method == SolverParameters::Method::mprgp ? mprgp.solve(current, state, contact_law)
                              : controls.method == SolverParameters::Method::apgd
                                ? apgd.solve(current, state, contact_law)
+                             : controls.method == SolverParameters::Method::apgs
+                               ? apgs.solve(current, state, contact_law)
                                : interior_point.solve(current, state, contact_law);
         report.iterations += sweeps;
         return report;

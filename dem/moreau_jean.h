@@ -15,6 +15,7 @@
 
 #include "dem/active_set.h"
 #include "dem/apgd.h"
+#include "dem/apgs.h"
 #include "dem/boundary.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
@@ -172,6 +173,7 @@ namespace tribo::dem
     ActiveSetSolver          active_set;
     MprgpSolver              mprgp;
     ApgdSolver               apgd;
+    ApgsSolver               apgs;
     InteriorPointSolver      interior_point;
     NlgsSolver               predictor; ///< the active set's predictor sweeps
     double                   distance;

@@ -38,7 +38,7 @@ namespace tribo::dem
     /// The method: nonlinear Gauss-Seidel (below); on the frictionless problem, the
     /// active-set (projected Newton) method with the sparse Delassus operator factorised
     /// by CHOLMOD (dem/active_set.h), the matrix-free MPRGP (dem/mprgp.h) and APGD
-    /// (dem/apgd.h) or the primal-dual interior-point method, also with CHOLMOD
+    /// (dem/apgd.h), APGS, Gauss-Seidel sweeps with momentum (dem/apgs.h), or the primal-dual interior-point method, also with CHOLMOD
     /// (dem/interior_point.h). With
     /// friction the global methods hand the step to NLGS and say so.
     enum class Method
@@ -47,7 +47,8 @@ namespace tribo::dem
       active_set,
       mprgp,
       interior_point,
-      apgd
+      apgd,
+      apgs
     };
     Method method = Method::nlgs; ///< (a case file's default is apgd: dem/parameters.cc)
     /// NLGS's stopping entries (Tolerance, Norm, Check interval, Gap tolerance) a case file set although
@@ -146,6 +147,8 @@ namespace tribo::dem
           return "interior-point";
         case SolverParameters::Method::apgd:
           return "apgd";
+        case SolverParameters::Method::apgs:
+          return "apgs";
         default:
           return "nlgs";
       }

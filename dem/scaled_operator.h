@@ -55,6 +55,13 @@ namespace tribo::dem
 
     /// Prepare the row products with @p v (computes U'^T v); call before row_times(v, .).
     void set_vector(const Eigen::VectorXd &v);
+    /// After v_j changed by @p change in place: keep U'^T v current (Gauss-Seidel sweeps,
+    /// dem/apgs.h), O(the row's low-rank entries).
+    void add_to_low_rank(Eigen::Index j, double change)
+    {
+      for (Eigen::Index q = low_rank_start[j]; q < low_rank_start[j + 1]; ++q)
+        Ut_v[low_rank_column[q]] += low_rank_value[q] * change;
+    }
     /// ((A' + U'U'^T) v)_j for the v given to set_vector.
     double row_times(const Eigen::VectorXd &v, Eigen::Index j) const
     {

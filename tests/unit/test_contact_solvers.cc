@@ -74,7 +74,9 @@ namespace
     interior_point.residual_target = 1e-11;
     SolverParameters apgd = mprgp;
     apgd.method           = SolverParameters::Method::apgd;
-    return {active_set(), mprgp, interior_point, apgd};
+    SolverParameters apgs = mprgp;
+    apgs.method           = SolverParameters::Method::apgs;
+    return {active_set(), mprgp, interior_point, apgd, apgs};
   }
 
   /// The law residual @p prm's method reaches when asked for 1e-11: the interior-point
@@ -208,8 +210,10 @@ TEST(ContactSolvers, GlobalMethodsWithTheWallAsLowRankMatchConvergedNlgs)
   mprgp.max_iterations  = 100000;
   SolverParameters apgd = mprgp;
   apgd.method           = SolverParameters::Method::apgd;
+  SolverParameters apgs = mprgp; // its sweeps keep the wall's low-rank part current in place
+  apgs.method           = SolverParameters::Method::apgs;
   const Eigen::VectorXd v_nlgs = velocities_after(s, ContactLaw{}, nlgs_converged(), 3);
-  for (const SolverParameters &prm : {ipm, mprgp, apgd})
+  for (const SolverParameters &prm : {ipm, mprgp, apgd, apgs})
     {
       std::vector<SolveReport> reports;
       const Eigen::VectorXd    v = velocities_after(s, ContactLaw{}, prm, 3, &reports);
@@ -273,7 +277,8 @@ TEST(ContactSolvers, GlobalMethodsCarryTheAppliedForceOfADiscOnAWall)
         {
           EXPECT_TRUE(report.solver.converged) << name;
         }
-      if (prm.method == SolverParameters::Method::mprgp || prm.method == SolverParameters::Method::apgd)
+      if (prm.method == SolverParameters::Method::mprgp || prm.method == SolverParameters::Method::apgd ||
+          prm.method == SolverParameters::Method::apgs)
         {
           EXPECT_GE(report.solver.iterations, 1u);
         }
