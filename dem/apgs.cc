@@ -2,6 +2,8 @@
 
 #include "dem/scaled_operator.h"
 
+#include <deal.II/base/parallel.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -33,11 +35,41 @@ namespace tribo::dem
         }
       return worst / (loaded > 0 ? loaded_sum / loaded : lcp.scale);
     };
+    // The sweep's order: the contacts (in detection order, rows of cells upwards) cut into
+    // slab_count slabs of consecutive contacts, the even slabs first, then the odd ones.
+    // When no contact couples two slabs that are not neighbours and the walls' low-rank rows
+    // lie in one slab, the slabs of one colour share nothing and run concurrently, with the
+    // same bits on any number of threads; otherwise one slab holds every contact.
+    std::vector<Eigen::Index> slab_start{0, n};
+    {
+      const Eigen::Index count = std::max<Eigen::Index>(1, std::min<Eigen::Index>(slab_count, n / 64) / 2 * 2);
+      std::vector<Eigen::Index> start(count + 1);
+      for (Eigen::Index q = 0; q <= count; ++q)
+        start[q] = q * n / count;
+      auto slab_of = [&](Eigen::Index j) {
+        return Eigen::Index(std::upper_bound(start.begin(), start.end(), j) - start.begin()) - 1;
+      };
+      bool         separate = count >= 2;
+      Eigen::Index low_rank_slab = -1;
+      for (Eigen::Index j = 0; j < n && separate; ++j)
+        {
+          const Eigen::Index s = slab_of(j);
+          for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a && separate; ++a)
+            separate = std::abs(slab_of(a.row()) - s) <= 1;
+          if (scaled.U.cols() > 0 && scaled.U.row(j).squaredNorm() > 0)
+            {
+              separate = separate && (low_rank_slab < 0 || low_rank_slab == s);
+              low_rank_slab = s;
+            }
+        }
+      if (separate)
+        slab_start = start;
+    }
+    const Eigen::Index slabs = Eigen::Index(slab_start.size()) - 1;
+    report.concurrent        = slabs > 1 && prm.threads > 1;
     // One projected Gauss-Seidel sweep of v in place (unit diagonal: A'_jj + |U'_j|^2 = 1).
-    auto sweep = [&](Eigen::VectorXd &v) {
-      ++report.iterations;
-      op.set_vector(v);
-      for (Eigen::Index j = 0; j < n; ++j)
+    auto sweep_slab = [&](Eigen::VectorXd &v, Eigen::Index q) {
+      for (Eigen::Index j = slab_start[q]; j < slab_start[q + 1]; ++j)
         {
           const double next = std::max(0.0, v[j] - (op.row_times(v, j) + b[j]));
           if (next != v[j])
@@ -45,6 +77,22 @@ namespace tribo::dem
               op.add_to_low_rank(j, next - v[j]);
               v[j] = next;
             }
+        }
+    };
+    auto sweep = [&](Eigen::VectorXd &v) {
+      ++report.iterations;
+      op.set_vector(v);
+      for (const Eigen::Index colour : {0, 1})
+        {
+          const Eigen::Index count = (slabs - colour + 1) / 2; // slabs colour, colour + 2, ...
+          auto work = [&](Eigen::Index first, Eigen::Index last) {
+            for (Eigen::Index k = first; k < last; ++k)
+              sweep_slab(v, colour + 2 * k);
+          };
+          if (prm.threads > 1 && count > 1)
+            dealii::parallel::apply_to_subranges(Eigen::Index(0), count, work, 1);
+          else
+            work(0, count);
         }
     };
 

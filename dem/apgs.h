@@ -16,11 +16,18 @@
 /// max_i |min(y_i, g_i)| / sqrt(D_i) at most SolverParameters::residual_target times the
 /// mean loaded impulse, or after SolverParameters::max_iterations sweeps plus products.
 ///
+/// A sweep's order: the contacts in detection order (rows of cells upwards) cut into
+/// slab_count slabs of consecutive contacts, the even slabs first, then the odd ones. When
+/// no contact couples slabs that are not neighbours and the walls' low-rank rows lie in one
+/// slab (checked every solve), the slabs of one colour share no row and are swept
+/// concurrently with SolverParameters::threads > 1, with the same bits on any number of
+/// threads (SolveReport::concurrent says so); otherwise one slab holds every contact.
+///
 /// A sweep carries a change along a whole force chain in the contacts' order, as NLGS does,
-/// and the momentum accelerates it as APGD's accelerates the gradient: at a residual of 1e-4
-/// it takes 0.62-0.78 times APGD's time per step from 1000 to 16 000 grains; at 1e-3 it is
-/// no faster beyond 4000 grains (docs/performance.md). The sweeps are sequential: one core
-/// whatever SolverParameters::threads.
+/// and the momentum accelerates it as APGD's accelerates the gradient (docs/performance.md:
+/// on one core 0.55-0.67 times APGD's time per step at a residual of 1e-4 from 1000 to
+/// 16 000 grains, 0.92-0.94 at 1e-3; on two threads faster up to 4000 grains, not at
+/// 16 000).
 
 #include "dem/frictionless_solver.h"
 
@@ -32,6 +39,8 @@ namespace tribo::dem
     using FrictionlessSolver::FrictionlessSolver;
     /// Sweeps between natural-map checks.
     static constexpr unsigned int check_interval = 10;
+    /// Slabs of consecutive contacts of a sweep (dem/apgs.cc): even ones, then odd ones.
+    static constexpr long slab_count = 8;
     /// The report's iterations are the sweeps plus the products of the checks.
     SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
 

@@ -220,6 +220,24 @@ namespace
 }
 } // namespace
 
+TEST(NlgsBands, ApgsGivesTheSameStateOnAnyNumberOfThreads)
+{
+  // APGS sweeps its slabs of one colour concurrently (dem/apgs.cc): they share no contact's
+  // row, so the order of their updates does not matter.
+  expect_same_state_on_any_number_of_threads(SolverParameters::Method::apgs);
+  // ... and on this layer the slabs are separate, so the threads did share the sweeps.
+  ParticleSystem   s = tall_layer();
+  SolverParameters prm;
+  prm.method           = SolverParameters::Method::apgs;
+  prm.predictor_sweeps = 0;
+  prm.threads          = 2;
+  MoreauJean   mj(0.5, ContactLaw{}, prm, 5e-8);
+  unsigned int concurrent = 0;
+  for (int i = 0; i < 20; ++i)
+    concurrent += mj.step(s, 1e-9).solver.concurrent;
+  EXPECT_GT(concurrent, 0u);
+}
+
 TEST(NlgsBands, MprgpGivesTheSameStateOnAnyNumberOfThreads)
 {
   // The products and sums of MPRGP are made per fixed chunk of 256 contacts and added in
