@@ -74,7 +74,7 @@ namespace tribo::dem
                       "problem, the sparse Delassus operator factorised by CHOLMOD), 'mprgp' "
                       "(matrix-free projected conjugate gradient with proportioning), 'apgs' "
                       "(projected Gauss-Seidel sweeps with Nesterov momentum, both cores with Threads = 2: "
-                      "0.55-0.67 times APGD's time at a residual of 1e-4 on one core) or "
+                      "0.51-0.67 times APGD's time at a residual of 1e-4 on one core) or "
                       "'interior-point' (Mehrotra's predictor-corrector, CHOLMOD: the one that "
                       "reaches 1e-8 on dense packings). All but nlgs stop at Residual target; with "
                       "friction their steps use NLGS and the log says so.");
