@@ -62,17 +62,7 @@ namespace tribo::dem
     const double nu = 1e-2 * std::max({(y.array() > 0).any() ? lcp.mean_loaded(y) : 0.0,
                                         b.cwiseAbs().mean(), 1e-300});
     // The warm start's mean loaded impulse (N s/m; 0 without one), for the crossover.
-    double warm_mean = 0;
-    {
-      double sum = 0, count = 0;
-      for (Eigen::Index i = 0; i < n; ++i)
-        if (y[i] > 0)
-          {
-            sum += y[i] * inv_root[i];
-            ++count;
-          }
-      warm_mean = count > 0 ? sum / count : 0.0;
-    }
+    const double warm_mean = (lcp.x.array() > 0).any() ? lcp.mean_loaded(lcp.x) : 0.0;
     y               = y.cwiseMax(nu);
     Eigen::VectorXd g = product(y) + b, s = g.cwiseMax(nu);
 
