@@ -1,8 +1,6 @@
 #include "dem/interior_point.h"
 
-#include "dem/frictionless_problem.h"
-
-#include <Eigen/CholmodSupport>
+#include "dem/crossover.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,20 +14,13 @@ namespace tribo::dem
     /// the factorisations per step by 15 % on the 3800-grain benchmark).
     constexpr unsigned int centrality_correctors = 2;
 
-    /// The crossover (InteriorPointSolver): tried once the natural map is below this
-    /// fraction of the mean impulse ...
+    /// The crossover (dem/crossover.h): tried once the natural map is below this fraction
+    /// of the mean impulse ...
     constexpr double crossover_below = 1e-4;
     /// ... and the closed set changed by at most this many contacts in the last iteration;
     constexpr unsigned int crossover_set_changes = 3;
-    /// at most this many attempts per solve, each one factorisation;
+    /// at most this many attempts per solve, each one factorisation.
     constexpr unsigned int crossover_attempts = 3;
-    /// the closed block factorised as A'_CC + shift I to precondition the conjugate gradients;
-    constexpr double crossover_shift = 1e-8;
-    /// conjugate-gradient iterations per pass, at most (1-12 when it succeeds);
-    constexpr unsigned int crossover_iterations = 15;
-    /// a candidate whose mean impulse exceeds the warm start's by more than this factor is
-    /// refused (the redundant directions' component must not grow from step to step).
-    constexpr double crossover_growth_limit = 1.5;
 
     /// The largest alpha in (0, 1] with v + alpha dv >= 0, times @p fraction when limited.
     double step_to_boundary(const Eigen::VectorXd &v, const Eigen::VectorXd &dv, double fraction)
@@ -50,8 +41,6 @@ namespace tribo::dem
     // The scaled problem (dem/mprgp.h).
     FrictionlessProblem::Scaled       scaled   = lcp.scaled();
     const Eigen::VectorXd            &inv_root = scaled.inv_root;
-    const Eigen::SparseMatrix<double> &A        = scaled.A;
-    const Eigen::MatrixXd            &U        = scaled.U;
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
     // The operator A' + U U^T (the walls as low-rank columns, dem/delassus.h).
@@ -74,40 +63,10 @@ namespace tribo::dem
       return worst;
     };
 
-    Eigen::SparseMatrix<double> K = A;
-    Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
-    cholesky.cholmod().print = 0; // a failed factorisation is handled below, not printed
-    // Simplicial: with Debian's reference BLAS, 1.7 times faster than supernodal on the
-    // 3800-grain benchmark's K (docs/performance.md).
-    cholesky.setMode(Eigen::CholmodSimplicialLLt);
-    cholesky.analyzePattern(K);
-    std::vector<double *> diagonal(n);
-    Eigen::VectorXd       unit(n); // the diagonal of the factorised A' (1 up to round-off; 1 - |U_i|^2 with low-rank walls)
-    for (Eigen::Index j = 0; j < n; ++j)
-      {
-        diagonal[j] = &K.coeffRef(j, j);
-        unit[j]     = *diagonal[j];
-      }
+    ShiftedFactorisation K(scaled);
     Eigen::VectorXd r(n), rhs(n), dy(n), ds(n), dy_a(n), ds_a(n), dy_c(n), ds_c(n);
-    // K = K_s + U U^T solved through K_s's factorisation (Sherman-Morrison-Woodbury):
-    // K^-1 v = K_s^-1 v - Z (I + U^T Z)^-1 U^T K_s^-1 v, Z = K_s^-1 U.
-    Eigen::MatrixXd          Z;
-    Eigen::LDLT<Eigen::MatrixXd> capacitance;
-    // With the low-rank part, one step of iterative refinement against K itself (the
-    // update loses digits that the plain factorisation keeps: docs/performance.md).
     Eigen::VectorXd barrier(n); // s / y + shift, K's diagonal beyond A'
-    auto woodbury = [&](const Eigen::VectorXd &v) -> Eigen::VectorXd {
-      Eigen::VectorXd t = cholesky.solve(v);
-      t -= Z * capacitance.solve(U.transpose() * t);
-      return t;
-    };
-    auto solve = [&](const Eigen::VectorXd &v) -> Eigen::VectorXd {
-      if (U.cols() == 0)
-        return cholesky.solve(v);
-      Eigen::VectorXd t = woodbury(v);
-      t += woodbury(v - product(t) - barrier.cwiseProduct(t));
-      return t;
-    };
+    auto solve = [&](const Eigen::VectorXd &v) { return K.solve(v); };
     // Round-off floor: below 1e-6 of the mean impulse, two iterations in a row that do not
     // halve the natural map end the solve (K's condition grows like 1 / mu).
     double       worst = natural_map(), last_worst = std::numeric_limits<double>::infinity();
@@ -128,103 +87,12 @@ namespace tribo::dem
           }
       return count > 0 ? sum / count : lcp.scale;
     };
-    // K = A' + diag(barrier) factorised, with the Woodbury pieces of the low-rank part.
     auto factorise = [&]() {
-      for (Eigen::Index j = 0; j < n; ++j)
-        *diagonal[j] = unit[j] + barrier[j];
-      cholesky.factorize(K);
-      ++report.factorizations;
-      if (cholesky.info() != Eigen::Success)
-        return false;
-      if (U.cols() > 0)
-        {
-          Z = cholesky.solve(U);
-          capacitance.compute(Eigen::MatrixXd::Identity(U.cols(), U.cols()) + U.transpose() * Z);
-        }
-      return true;
+      const bool done       = K.factorise(barrier);
+      report.factorizations = K.factorizations;
+      return done;
     };
-    // The crossover: with C = {y_i > g_i} the closed set, the impulses that close C exactly,
-    // z = y + d with (A' + U U^T)_CC d = -g_C, d in the range of that block (the least-norm
-    // correction: nothing added along the redundant directions), z = 0 off C; contacts of
-    // C whose z_i < 0 open and d is solved again (at most twice). d by conjugate gradients
-    // from zero, preconditioned by the factorised A'_CC + shift I (barrier 1e20 off C).
-    // Accepted when z meets the target (natural map against the smaller of z's and the
-    // iterate's mean impulse) and its mean impulse is within crossover_growth_limit of the
-    // warm start's (docs/performance.md: the iterate carries an inflated component along
-    // the redundant directions, which a crossover from it would freeze and the next step
-    // inflate again).
     std::vector<char> closed(n, 0);
-    auto crossover = [&]() {
-      for (Eigen::Index j = 0; j < n; ++j)
-        barrier[j] = closed[j] ? crossover_shift : 1e20;
-      if (!factorise())
-        return false;
-      auto restrict_to_closed = [&](Eigen::VectorXd &v) {
-        for (Eigen::Index j = 0; j < n; ++j)
-          if (!closed[j])
-            v[j] = 0;
-      };
-      const double tolerance = 0.3 * prm.residual_target * mean_loaded();
-      auto close_exactly = [&]() {
-        Eigen::VectorXd z = y;
-        restrict_to_closed(z);
-        Eigen::VectorXd residual = -(product(z) + b);
-        restrict_to_closed(residual);
-        Eigen::VectorXd w = solve(residual);
-        restrict_to_closed(w);
-        Eigen::VectorXd direction = w, q;
-        double          rw        = residual.dot(w);
-        for (unsigned int k = 0; k < crossover_iterations; ++k)
-          {
-            q = product(direction);
-            restrict_to_closed(q);
-            const double curvature = direction.dot(q);
-            if (!(curvature > 0))
-              break;
-            const double a = rw / curvature;
-            z += a * direction;
-            residual -= a * q;
-            if ((residual.cwiseAbs().cwiseProduct(inv_root)).maxCoeff() <= tolerance)
-              break;
-            w = solve(residual);
-            restrict_to_closed(w);
-            const double rw_next = residual.dot(w);
-            direction            = w + (rw_next / rw) * direction;
-            rw                   = rw_next;
-          }
-        return z;
-      };
-      Eigen::VectorXd z = close_exactly();
-      for (unsigned int pass = 0; pass < 2 && z.minCoeff() < 0; ++pass)
-        {
-          for (Eigen::Index j = 0; j < n; ++j)
-            if (z[j] < 0)
-              closed[j] = 0;
-          z = close_exactly();
-        }
-      z                       = z.cwiseMax(0.0);
-      const Eigen::VectorXd gz = product(z) + b;
-      double                map = 0, sum = 0, count = 0;
-      for (Eigen::Index j = 0; j < n; ++j)
-        {
-          map = std::max(map, std::abs(std::min(z[j], gz[j])) * inv_root[j]);
-          if (z[j] > gz[j])
-            {
-              sum += z[j] * inv_root[j];
-              ++count;
-            }
-        }
-      const double z_mean = count > 0 ? sum / count : lcp.scale;
-      if (map > prm.residual_target * std::min(z_mean, mean_loaded()) || !(z_mean <= crossover_growth_limit * warm_mean))
-        return false;
-      y          = z;
-      g          = gz;
-      worst      = map;
-      best_worst = worst;
-      best_y     = y;
-      best_g     = g;
-      return true;
-    };
     unsigned int attempts = 0;
     while (worst > prm.residual_target * mean_loaded())
       {
@@ -240,8 +108,17 @@ namespace tribo::dem
             if (changed <= crossover_set_changes)
               {
                 ++attempts;
-                if (crossover())
-                  break;
+                const double map = least_norm_crossover(
+                  scaled, K, closed, {prm.residual_target, mean_loaded(), warm_mean}, y, g);
+                report.factorizations = K.factorizations;
+                if (map >= 0)
+                  {
+                    worst      = map;
+                    best_worst = worst;
+                    best_y     = y;
+                    best_g     = g;
+                    break;
+                  }
               }
           }
         stalled    = worst <= 1e-6 * mean_loaded() && worst > 0.5 * last_worst ? stalled + 1 : 0;

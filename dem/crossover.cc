@@ -1,0 +1,131 @@
+#include "dem/crossover.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tribo::dem
+{
+  ShiftedFactorisation::ShiftedFactorisation(const FrictionlessProblem::Scaled &problem)
+    : p(problem), K(problem.A), diagonal(problem.A.rows()), unit(problem.A.rows()),
+      barrier(Eigen::VectorXd::Zero(problem.A.rows()))
+  {
+    cholesky.cholmod().print = 0; // a failed factorisation is reported by factorise()
+    cholesky.setMode(Eigen::CholmodSimplicialLLt);
+    cholesky.analyzePattern(K);
+    for (Eigen::Index j = 0; j < K.rows(); ++j)
+      {
+        diagonal[j] = &K.coeffRef(j, j);
+        unit[j]     = *diagonal[j];
+      }
+  }
+
+  bool ShiftedFactorisation::factorise(const Eigen::VectorXd &b)
+  {
+    barrier = b;
+    for (Eigen::Index j = 0; j < K.rows(); ++j)
+      *diagonal[j] = unit[j] + barrier[j];
+    cholesky.factorize(K);
+    ++factorizations;
+    if (cholesky.info() != Eigen::Success)
+      return false;
+    if (p.U.cols() > 0)
+      {
+        Z = cholesky.solve(p.U);
+        capacitance.compute(Eigen::MatrixXd::Identity(p.U.cols(), p.U.cols()) + p.U.transpose() * Z);
+      }
+    return true;
+  }
+
+  Eigen::VectorXd ShiftedFactorisation::woodbury(const Eigen::VectorXd &v) const
+  {
+    Eigen::VectorXd t = cholesky.solve(v);
+    t -= Z * capacitance.solve(p.U.transpose() * t);
+    return t;
+  }
+
+  Eigen::VectorXd ShiftedFactorisation::solve(const Eigen::VectorXd &v) const
+  {
+    if (p.U.cols() == 0)
+      return cholesky.solve(v);
+    Eigen::VectorXd t = woodbury(v);
+    t += woodbury(v - p.product(t) - barrier.cwiseProduct(t));
+    return t;
+  }
+
+  double least_norm_crossover(const FrictionlessProblem::Scaled &p, ShiftedFactorisation &K,
+                              std::vector<char> &closed, const CrossoverTarget &target,
+                              Eigen::VectorXd &y, Eigen::VectorXd &g)
+  {
+    const Eigen::Index     n        = y.size();
+    const Eigen::VectorXd &inv_root = p.inv_root;
+    Eigen::VectorXd        barrier(n);
+    for (Eigen::Index j = 0; j < n; ++j)
+      barrier[j] = closed[j] ? crossover::shift : 1e20;
+    if (!K.factorise(barrier))
+      return -1;
+    auto restrict_to_closed = [&](Eigen::VectorXd &v) {
+      for (Eigen::Index j = 0; j < n; ++j)
+        if (!closed[j])
+          v[j] = 0;
+    };
+    const double tolerance = 0.3 * target.residual_target * target.iterate_mean;
+    // Preconditioned conjugate gradients on the closed block from d = 0.
+    auto close_exactly = [&]() {
+      Eigen::VectorXd z = y;
+      restrict_to_closed(z);
+      Eigen::VectorXd residual = -(p.product(z) + p.b);
+      restrict_to_closed(residual);
+      Eigen::VectorXd w = K.solve(residual);
+      restrict_to_closed(w);
+      Eigen::VectorXd direction = w, q;
+      double          rw        = residual.dot(w);
+      for (unsigned int k = 0; k < crossover::iterations; ++k)
+        {
+          q = p.product(direction);
+          restrict_to_closed(q);
+          const double curvature = direction.dot(q);
+          if (!(curvature > 0))
+            break;
+          const double a = rw / curvature;
+          z += a * direction;
+          residual -= a * q;
+          if ((residual.cwiseAbs().cwiseProduct(inv_root)).maxCoeff() <= tolerance)
+            break;
+          w = K.solve(residual);
+          restrict_to_closed(w);
+          const double rw_next = residual.dot(w);
+          direction            = w + (rw_next / rw) * direction;
+          rw                   = rw_next;
+        }
+      return z;
+    };
+    Eigen::VectorXd z = close_exactly();
+    for (unsigned int pass = 0; pass < 2 && z.minCoeff() < 0; ++pass)
+      {
+        for (Eigen::Index j = 0; j < n; ++j)
+          if (z[j] < 0)
+            closed[j] = 0;
+        z = close_exactly();
+      }
+    z                        = z.cwiseMax(0.0);
+    const Eigen::VectorXd gz = p.product(z) + p.b;
+    double                map = 0, sum = 0, count = 0;
+    for (Eigen::Index j = 0; j < n; ++j)
+      {
+        map = std::max(map, std::abs(std::min(z[j], gz[j])) * inv_root[j]);
+        if (z[j] > gz[j])
+          {
+            sum += z[j] * inv_root[j];
+            ++count;
+          }
+      }
+    // Without a closed contact the mean is the iterate's (nothing to compare).
+    const double z_mean = count > 0 ? sum / count : target.iterate_mean;
+    if (map > target.residual_target * std::min(z_mean, target.iterate_mean) ||
+        !(z_mean <= crossover::growth_limit * target.warm_mean))
+      return -1;
+    y = z;
+    g = gz;
+    return map;
+  }
+} // namespace tribo::dem
