@@ -19,21 +19,26 @@ namespace tribo::dem
     const Eigen::VectorXd      &b        = scaled.b;
     ScaledOperator              op(scaled);
 
-    // The natural map at y over its mean loaded impulse (one product).
+    // The natural map at y over its mean loaded impulse (one product); each contact's
+    // |min(y_j, g_j)| / sqrt(D_j) is kept in `error` and the mean in `mean_loaded` (N s/m).
+    Eigen::VectorXd error(n);
+    double          mean_loaded = lcp.scale;
     auto relative_map = [&](const Eigen::VectorXd &y) {
       ++report.iterations;
       op.set_vector(y);
       double worst = 0, loaded_sum = 0, loaded = 0;
       for (Eigen::Index j = 0; j < n; ++j)
         {
-          worst = std::max(worst, std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j]);
+          error[j] = std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
+          worst    = std::max(worst, error[j]);
           if (y[j] > 0)
             {
               loaded_sum += y[j] * inv_root[j];
               ++loaded;
             }
         }
-      return worst / (loaded > 0 ? loaded_sum / loaded : lcp.scale);
+      mean_loaded = loaded > 0 ? loaded_sum / loaded : lcp.scale;
+      return worst / mean_loaded;
     };
     // The sweep's order: the contacts (in detection order, rows of cells upwards) cut into
     // slab_count slabs of consecutive contacts, the even slabs first, then the odd ones.
@@ -96,8 +101,43 @@ namespace tribo::dem
         }
     };
 
+    // The local polish: projected Gauss-Seidel passes over the contacts above the target and
+    // their neighbours (the rows of their columns of A'), y changed in place and z by the
+    // same amount (the momentum y - y_last kept). False when nothing is above the target or
+    // the neighbourhood is too large to be local.
+    std::vector<char>         marked(n, 0);
+    std::vector<Eigen::Index> local;
+    auto polish = [&](Eigen::VectorXd &y, Eigen::VectorXd &z) {
+      const double threshold = prm.residual_target * mean_loaded;
+      std::fill(marked.begin(), marked.end(), 0);
+      local.clear();
+      for (Eigen::Index j = 0; j < n; ++j)
+        if (error[j] > threshold)
+          for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a; ++a)
+            marked[a.row()] = 1;
+      for (Eigen::Index j = 0; j < n; ++j)
+        if (marked[j])
+          local.push_back(j);
+      if (local.empty() || double(local.size()) > polish_fraction * double(n))
+        return false;
+      op.set_vector(y);
+      for (unsigned int pass = 0; pass < polish_passes; ++pass)
+        for (const Eigen::Index j : local)
+          {
+            const double next = std::max(0.0, y[j] - (op.row_times(y, j) + b[j]));
+            if (next != y[j])
+              {
+                op.add_to_low_rank(j, next - y[j]);
+                z[j] += next - y[j];
+                y[j] = next;
+              }
+          }
+      return true;
+    };
+
     Eigen::VectorXd y = scaled.y.cwiseMax(0.0), y_last(n), z = y, next(n);
-    double          t = 1;
+    double          t        = 1;
+    unsigned int    polished = 0; // polishes since the last sweep
     while (relative_map(y) > prm.residual_target)
       {
         if (report.iterations >= prm.max_iterations)
@@ -105,6 +145,12 @@ namespace tribo::dem
             report.converged = false;
             break;
           }
+        if (polished < polishes_per_check && polish(y, z))
+          {
+            ++polished;
+            continue;
+          }
+        polished = 0;
         for (unsigned int k = 0; k < check_interval; ++k)
           {
             next = z;
