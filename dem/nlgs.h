@@ -50,7 +50,7 @@ namespace tribo::dem
       apgd,
       apgs
     };
-    Method method = Method::nlgs; ///< (a case file's default is apgd: dem/parameters.cc)
+    Method method = Method::nlgs; ///< (a case file's default is apgs: dem/parameters.cc)
     /// NLGS's stopping entries (Tolerance, Norm, Check interval, Gap tolerance) a case file set although
     /// the method is another, with where they were set ("Solver/Tolerance (case.prm:24)"):
     /// they then act only on the steps NLGS solves (friction), and the run log says so.

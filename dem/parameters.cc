@@ -65,16 +65,16 @@ namespace tribo::dem
 
   void SolverParameters::declare(dealii::ParameterHandler &prm)
   {
-    prm.declare_entry("Method", "apgd", Selection("nlgs|active-set|mprgp|interior-point|apgd|apgs"),
-                      "Contact solver: 'apgd' (the default: matrix-free accelerated projected "
-                      "gradient with restart, both cores with Threads = 2; the fastest measured at "
-                      "residuals of 1e-3 to 7e-3, on the main job and the established code's sample, "
-                      "docs/performance.md), 'nlgs' (nonlinear Gauss-Seidel, the entries Tolerance to "
-                      "Streams below), 'active-set' (projected Newton method on the frictionless "
-                      "problem, the sparse Delassus operator factorised by CHOLMOD), 'mprgp' "
-                      "(matrix-free projected conjugate gradient with proportioning), 'apgs' "
-                      "(projected Gauss-Seidel sweeps with Nesterov momentum, both cores with Threads = 2: "
-                      "0.51-0.67 times APGD's time at a residual of 1e-4 on one core) or "
+    prm.declare_entry("Method", "apgs", Selection("nlgs|active-set|mprgp|interior-point|apgd|apgs"),
+                      "Contact solver: 'apgs' (the default: projected Gauss-Seidel sweeps with "
+                      "Nesterov momentum and a local polish of the worst contacts, both cores with "
+                      "Threads = 2; the fastest measured on every shipped shear case that uses the "
+                      "default, docs/performance.md), 'apgd' (matrix-free accelerated projected "
+                      "gradient with restart, both cores with Threads = 2), 'nlgs' (nonlinear "
+                      "Gauss-Seidel, the entries Tolerance to Streams below), 'active-set' (projected "
+                      "Newton method on the frictionless problem, the sparse Delassus operator "
+                      "factorised by CHOLMOD), 'mprgp' (matrix-free projected conjugate gradient with "
+                      "proportioning) or "
                       "'interior-point' (Mehrotra's predictor-corrector, CHOLMOD: the one that "
                       "reaches 1e-8 on dense packings). All but nlgs stop at Residual target; with "
                       "friction their steps use NLGS and the log says so.");
