@@ -102,22 +102,32 @@ namespace tribo::dem
     };
 
     // The local polish: projected Gauss-Seidel passes over the contacts above the target and
-    // their neighbours (the rows of their columns of A'), y changed in place and z by the
-    // same amount (the momentum y - y_last kept). False when nothing is above the target or
-    // the neighbourhood is too large to be local.
+    // their neighbours up to polish_rings rings away in A' (ring 1: the rows of their
+    // columns), y changed in place and z by the same amount (the momentum y - y_last kept).
+    // False when nothing is above the target or the neighbourhood is too large to be local.
     std::vector<char>         marked(n, 0);
     std::vector<Eigen::Index> local;
     auto polish = [&](Eigen::VectorXd &y, Eigen::VectorXd &z) {
       const double threshold = prm.residual_target * mean_loaded;
-      std::fill(marked.begin(), marked.end(), 0);
       local.clear();
       for (Eigen::Index j = 0; j < n; ++j)
-        if (error[j] > threshold)
-          for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a; ++a)
-            marked[a.row()] = 1;
-      for (Eigen::Index j = 0; j < n; ++j)
-        if (marked[j])
-          local.push_back(j);
+        {
+          marked[j] = error[j] > threshold;
+          if (marked[j])
+            local.push_back(j);
+        }
+      for (unsigned int ring = 0; ring < polish_rings && double(local.size()) <= polish_fraction * double(n); ++ring)
+        {
+          const std::size_t inner = local.size();
+          for (std::size_t q = 0; q < inner; ++q)
+            for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, local[q]); a; ++a)
+              if (!marked[a.row()])
+                {
+                  marked[a.row()] = 1;
+                  local.push_back(a.row());
+                }
+        }
+      std::sort(local.begin(), local.end()); // the sweep's order
       if (local.empty() || double(local.size()) > polish_fraction * double(n))
         return false;
       op.set_vector(y);

@@ -23,16 +23,16 @@
 /// concurrently with SolverParameters::threads > 1, with the same bits on any number of
 /// threads (SolveReport::concurrent says so); otherwise one slab holds every contact.
 ///
-/// Local polish (since 2026-11-26, sixth session): after a check that fails, when the contacts above the
-/// target and their neighbours in A' are at most polish_fraction of all, polish_passes
-/// projected Gauss-Seidel passes over them alone (y changed in place, z by the same amount,
-/// so the momentum y - y_last is kept), then a new check; at most polishes_per_check times
-/// between two blocks of sweeps. The warm start's worst contacts are a tail whose error
-/// grows with the sample (its largest |min(y_j, g_j)| over the mean impulse 6e-3, 1.2e-2,
-/// 2.1e-2 and 4.8e-2 at 1000, 4000, 16 000 and 64 000 grains, while its root mean square
-/// stays near 6e-4): whole sweeps spent on that tail are what made the sweeps grow with the
-/// width, and the polish works on it alone (docs/performance.md: 0.8 times the time per step
-/// at 4000 and 16 000 grains at 1e-3).
+/// Local polish (since 2026-11-26, sixth session): after a check that fails, the contacts
+/// above the target and their neighbours up to polish_rings rings away in A' (while they are
+/// at most polish_fraction of all) get polish_passes projected Gauss-Seidel passes, in the
+/// sweep's order, over them alone (y changed in place, z by the same amount, so the momentum
+/// y - y_last is kept), then a new check; at most polishes_per_check times between two
+/// blocks of sweeps. The warm start's worst contacts are a tail whose error grows with the
+/// sample (its largest |min(y_j, g_j)| over the mean impulse 6e-3, 1.2e-2, 2.1e-2 and 4.8e-2
+/// at 1000, 4000, 16 000 and 64 000 grains, while its root mean square stays near 6e-4):
+/// whole sweeps spent on that tail are what made the sweeps grow with the width, and the
+/// polish works on it alone (docs/performance.md, "APGS's local polish").
 ///
 /// A sweep carries a change along a whole force chain in the contacts' order, as NLGS does,
 /// and the momentum accelerates it as APGD's accelerates the gradient (docs/performance.md:
@@ -54,8 +54,10 @@ namespace tribo::dem
     /// The local polish after a check that fails: passes over the contacts above the target
     /// and their neighbours, ...
     static constexpr unsigned int polish_passes = 3;
+    /// ... and their neighbours up to this many rings away in A', ...
+    static constexpr unsigned int polish_rings = 2;
     /// ... at most this many polishes (each followed by a check) between two blocks of sweeps,
-    static constexpr unsigned int polishes_per_check = 2;
+    static constexpr unsigned int polishes_per_check = 4;
     /// ... and only while those contacts are at most this fraction of all.
     static constexpr double polish_fraction = 0.05;
     /// The report's iterations are the sweeps plus the products of the checks.
