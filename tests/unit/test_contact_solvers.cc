@@ -1,5 +1,6 @@
 // The sparse Delassus operator, the law residual and the active-set method against
 // the dense operator, closed forms and NLGS converged to 1e-12.
+#include "dem/apgs.h"
 #include "dem/delassus.h"
 #include "dem/law_residual.h"
 #include "dem/moreau_jean.h"
@@ -253,6 +254,53 @@ TEST(ContactSolvers, LawResidualIsZeroWhenSolvedAndPositiveWhenAContactIsLeftUns
   const LawResidual unsolved = law_residual(contacts, state, law, 0.5 * h);
   EXPECT_GT(unsolved.relative, 0.1);
   EXPECT_GT(unsolved.gap_violation, 0.0);
+}
+
+TEST(ContactSolvers, ApgsPolishesOneWrongContactWithoutAWholeSweep)
+{
+  // A converged wide stack (300 columns, about 2700 contacts) with the impulse of its most
+  // loaded contact removed: the contacts above the target are that one and its bodies'
+  // other contacts, far fewer than ApgsSolver::polish_fraction of all, so the local polish
+  // (dem/apgs.h) restores the solution to the target between checks, before any block of
+  // ApgsSolver::check_interval sweeps (without it: one check, 10 sweeps, one check at least).
+  ParticleSystem   s = hexagonal_stack(30000, 0, 300);
+  const ContactLaw law;
+  SolverParameters converged;
+  converged.method          = SolverParameters::Method::apgs;
+  converged.residual_target = 1e-11;
+  converged.max_iterations  = 100000;
+  MoreauJean mj(0.5, law, converged, 0.1 * radius);
+  for (int i = 0; i < 20; ++i)
+    mj.step(s, h);
+  std::vector<Contact> contacts = mj.contacts();
+  BodyState            state    = BodyState::of(s);
+  ASSERT_LT(law_residual(contacts, state, law, 0.5 * h).relative, 1e-10);
+  // The most loaded contact between two grains (the walls, bodies 0 and the last, touch
+  // every contact of their row).
+  const unsigned int upper_wall = s.bodies.size() - 1;
+  auto between_grains = [&](const Contact &c) {
+    return c.body[0] != 0 && c.body[1] != 0 && c.body[0] != upper_wall && c.body[1] != upper_wall;
+  };
+  std::size_t loaded = contacts.size();
+  for (std::size_t i = 0; i < contacts.size(); ++i)
+    if (between_grains(contacts[i]) && (loaded == contacts.size() || contacts[i].r.x() > contacts[loaded].r.x()))
+      loaded = i;
+  ASSERT_LT(loaded, contacts.size());
+  const Eigen::Vector2d r = contacts[loaded].r;
+  state.apply_impulse(contacts[loaded], -r);
+  contacts[loaded].r.setZero();
+  ASSERT_GT(law_residual(contacts, state, law, 0.5 * h).relative, 0.1);
+
+  SolverParameters prm;
+  prm.method          = SolverParameters::Method::apgs;
+  prm.residual_target = 1e-3; // the shipped cases' accuracy (tighter, the local passes converge slowly)
+  ApgsSolver        apgs(prm);
+  const SolveReport report = apgs.solve(contacts, state, law);
+  EXPECT_TRUE(report.converged);
+  EXPECT_GE(report.iterations, 2u);                          // the first check failed
+  EXPECT_LT(report.iterations, ApgsSolver::check_interval); // checks only, no sweep
+  // A solution (the stack is hyperstatic: its impulses need not be the removed ones).
+  EXPECT_LT(law_residual(contacts, state, law, 0.5 * h).relative, prm.residual_target);
 }
 
 TEST(ContactSolvers, GlobalMethodsCarryTheAppliedForceOfADiscOnAWall)
