@@ -23,22 +23,37 @@ namespace tribo::dem
     // |min(y_j, g_j)| / sqrt(D_j) is kept in `error` and the mean in `mean_loaded` (N s/m).
     Eigen::VectorXd error(n);
     double          mean_loaded = lcp.scale;
+    // Over fixed chunks (dem/scaled_operator.h), concurrently with Threads > 1, the same
+    // bits on any number of threads.
+    struct MapSums
+    {
+      double worst = 0, loaded_sum = 0, loaded = 0;
+      void   merge(const MapSums &p)
+      {
+        worst = std::max(worst, p.worst);
+        loaded_sum += p.loaded_sum;
+        loaded += p.loaded;
+      }
+    };
     auto relative_map = [&](const Eigen::VectorXd &y) {
       ++report.iterations;
       op.set_vector(y);
-      double worst = 0, loaded_sum = 0, loaded = 0;
-      for (Eigen::Index j = 0; j < n; ++j)
-        {
-          error[j] = std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
-          worst    = std::max(worst, error[j]);
-          if (y[j] > 0)
-            {
-              loaded_sum += y[j] * inv_root[j];
-              ++loaded;
-            }
-        }
-      mean_loaded = loaded > 0 ? loaded_sum / loaded : lcp.scale;
-      return worst / mean_loaded;
+      const MapSums sums = over_chunks<MapSums>(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+        MapSums part;
+        for (Eigen::Index j = first; j < last; ++j)
+          {
+            error[j]   = std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
+            part.worst = std::max(part.worst, error[j]);
+            if (y[j] > 0)
+              {
+                part.loaded_sum += y[j] * inv_root[j];
+                ++part.loaded;
+              }
+          }
+        return part;
+      });
+      mean_loaded = sums.loaded > 0 ? sums.loaded_sum / sums.loaded : lcp.scale;
+      return sums.worst / mean_loaded;
     };
     // The sweep's order: the contacts (in detection order, rows of cells upwards) cut into
     // slab_count slabs of consecutive contacts, the even slabs first, then the odd ones.
@@ -161,20 +176,34 @@ namespace tribo::dem
             continue;
           }
         polished = 0;
+        // The vector passes over fixed chunks, as the check (the same bits on any number of
+        // threads); the next sweep's start (next = z) written with z.
+        struct Sum
+        {
+          double value = 0;
+          void   merge(const Sum &p) { value += p.value; }
+        };
+        next = z;
         for (unsigned int k = 0; k < check_interval; ++k)
           {
-            next = z;
             sweep(next);
-            double opposed = 0;
-            for (Eigen::Index j = 0; j < n; ++j)
-              opposed += (z[j] - next[j]) * (next[j] - y[j]);
+            const double opposed = over_chunks<Sum>(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+              Sum part;
+              for (Eigen::Index j = first; j < last; ++j)
+                part.value += (z[j] - next[j]) * (next[j] - y[j]);
+              return part;
+            }).value;
             if (opposed > 0)
               t = 1;
             const double t_next = 0.5 * (1 + std::sqrt(1 + 4 * t * t));
             const double beta   = (t - 1) / t_next;
             y_last.swap(y);
             y.swap(next);
-            z = y + beta * (y - y_last);
+            over_chunks<NoSums>(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+              for (Eigen::Index j = first; j < last; ++j)
+                next[j] = z[j] = y[j] + beta * (y[j] - y_last[j]);
+              return NoSums{};
+            });
             t = t_next;
           }
       }
