@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace tribo::dem
 {
@@ -131,10 +132,11 @@ namespace tribo::dem
           if (marked[j])
             local.push_back(j);
         }
+      std::size_t last_ring = 0; // local[last_ring, ...) is the outermost ring so far
       for (unsigned int ring = 0; ring < polish_rings && double(local.size()) <= polish_fraction * double(n); ++ring)
         {
           const std::size_t inner = local.size();
-          for (std::size_t q = 0; q < inner; ++q)
+          for (std::size_t q = std::exchange(last_ring, inner); q < inner; ++q)
             for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, local[q]); a; ++a)
               if (!marked[a.row()])
                 {
