@@ -5,10 +5,12 @@
 
 namespace tribo::dem
 {
-  ShiftedFactorisation::ShiftedFactorisation(const FrictionlessProblem::Scaled &problem)
+  ShiftedFactorisation::ShiftedFactorisation(const FrictionlessProblem::Scaled &problem, unsigned int threads)
     : p(problem), K(problem.A), diagonal(problem.A.rows()), unit(problem.A.rows()),
-      barrier(Eigen::VectorXd::Zero(problem.A.rows()))
+      barrier(Eigen::VectorXd::Zero(problem.A.rows())), halves(problem.A, threads > 1)
   {
+    if (halves.split())
+      return;
     cholesky.cholmod().print = 0; // a failed factorisation is reported by factorise()
     cholesky.setMode(Eigen::CholmodSimplicialLLt);
     cholesky.analyzePattern(K);
@@ -22,23 +24,46 @@ namespace tribo::dem
   bool ShiftedFactorisation::factorise(const Eigen::VectorXd &b)
   {
     barrier = b;
-    for (Eigen::Index j = 0; j < K.rows(); ++j)
-      *diagonal[j] = unit[j] + barrier[j];
-    cholesky.factorize(K);
     ++factorizations;
-    if (cholesky.info() != Eigen::Success)
-      return false;
+    if (halves.split())
+      {
+        if (!halves.factorise(barrier))
+          return false;
+      }
+    else
+      {
+        for (Eigen::Index j = 0; j < K.rows(); ++j)
+          *diagonal[j] = unit[j] + barrier[j];
+        cholesky.factorize(K);
+        if (cholesky.info() != Eigen::Success)
+          return false;
+      }
     if (p.U.cols() > 0)
       {
-        Z = cholesky.solve(p.U);
+        Z = solve_sparse(p.U);
         capacitance.compute(Eigen::MatrixXd::Identity(p.U.cols(), p.U.cols()) + p.U.transpose() * Z);
       }
     return true;
   }
 
+  Eigen::VectorXd ShiftedFactorisation::solve_sparse(const Eigen::VectorXd &v) const
+  {
+    return halves.split() ? halves.solve(v) : Eigen::VectorXd(cholesky.solve(v));
+  }
+
+  Eigen::MatrixXd ShiftedFactorisation::solve_sparse(const Eigen::MatrixXd &V) const
+  {
+    if (!halves.split())
+      return cholesky.solve(V);
+    Eigen::MatrixXd X(V.rows(), V.cols());
+    for (Eigen::Index c = 0; c < V.cols(); ++c)
+      X.col(c) = halves.solve(V.col(c));
+    return X;
+  }
+
   Eigen::VectorXd ShiftedFactorisation::woodbury(const Eigen::VectorXd &v) const
   {
-    Eigen::VectorXd t = cholesky.solve(v);
+    Eigen::VectorXd t = solve_sparse(v);
     t -= Z * capacitance.solve(p.U.transpose() * t);
     return t;
   }
@@ -46,7 +71,7 @@ namespace tribo::dem
   Eigen::VectorXd ShiftedFactorisation::solve(const Eigen::VectorXd &v) const
   {
     if (p.U.cols() == 0)
-      return cholesky.solve(v);
+      return solve_sparse(v);
     Eigen::VectorXd t = woodbury(v);
     t += woodbury(v - p.product(t) - barrier.cwiseProduct(t));
     return t;

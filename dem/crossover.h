@@ -9,6 +9,7 @@
 ///   impulses that close C exactly (the interior point's crossover; from APGD's or APGS's
 ///   iterates it fails, docs/performance.md).
 
+#include "dem/bisected_cholesky.h"
 #include "dem/frictionless_problem.h"
 
 #include <Eigen/CholmodSupport>
@@ -19,8 +20,10 @@ namespace tribo::dem
 {
   /// K = A' + diag(barrier) + U'U'^T of a scaled problem, factorised by CHOLMOD (simplicial
   /// LL^T: 1.7 times faster than its supernodal one with Debian's reference BLAS on the
-  /// 3800-grain benchmark, docs/performance.md). The symbolic analysis is made once, by the
-  /// constructor; each factorise() is one numeric factorisation. A wall clump touched by m
+  /// 3800-grain benchmark, docs/performance.md); with @p threads > 1, from 4000 contacts and
+  /// when METIS finds a small separator, in two halves on both cores
+  /// (dem/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
+  /// each factorise() is one numeric factorisation. A wall clump touched by m
   /// contacts would make an m x m dense block: it stays out as U'U'^T, K_s = K - U'U'^T is
   /// factorised and K solved by Woodbury, K^-1 v = K_s^-1 v - Z (I + U'^T Z)^-1 U'^T K_s^-1 v
   /// with Z = K_s^-1 U', plus one step of iterative refinement against K (the update loses
@@ -28,7 +31,7 @@ namespace tribo::dem
   class ShiftedFactorisation
   {
   public:
-    explicit ShiftedFactorisation(const FrictionlessProblem::Scaled &p);
+    ShiftedFactorisation(const FrictionlessProblem::Scaled &p, unsigned int threads);
     /// Factorise K with this @p barrier (dimensionless, >= 0, one per contact); false if
     /// CHOLMOD fails (K numerically not positive definite).
     bool factorise(const Eigen::VectorXd &barrier);
@@ -44,6 +47,10 @@ namespace tribo::dem
     Eigen::VectorXd                    unit;     ///< A''s diagonal (1 - |U'_i|^2 with low-rank walls)
     Eigen::VectorXd                    barrier;
     Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+    BisectedCholesky                   halves;
+    /// K_s^-1 @p v (K_s = A' + diag(barrier)), whole or in halves.
+    Eigen::VectorXd                    solve_sparse(const Eigen::VectorXd &v) const;
+    Eigen::MatrixXd                    solve_sparse(const Eigen::MatrixXd &V) const;
     Eigen::MatrixXd                    Z;
     Eigen::LDLT<Eigen::MatrixXd>       capacitance;
     Eigen::VectorXd                    woodbury(const Eigen::VectorXd &v) const;

@@ -63,7 +63,7 @@ namespace tribo::dem
       return worst;
     };
 
-    ShiftedFactorisation K(scaled);
+    ShiftedFactorisation K(scaled, prm.threads);
     Eigen::VectorXd r(n), rhs(n), dy(n), ds(n), dy_a(n), ds_a(n), dy_c(n), ds_c(n);
     Eigen::VectorXd barrier(n); // s / y + shift, K's diagonal beyond A'
     auto solve = [&](const Eigen::VectorXd &v) { return K.solve(v); };

@@ -1,7 +1,9 @@
 // The sparse Delassus operator, the law residual and the active-set method against
 // the dense operator, closed forms and NLGS converged to 1e-12.
 #include "dem/apgs.h"
+#include "dem/bisected_cholesky.h"
 #include "dem/delassus.h"
+#include "dem/frictionless_problem.h"
 #include "dem/law_residual.h"
 #include "dem/moreau_jean.h"
 
@@ -465,5 +467,44 @@ TEST(ContactSolvers, InteriorPointReachesATightTargetAtEveryWarmStartedStepOfAHy
     {
       EXPECT_TRUE(reports[step].converged) << "step " << step;
       EXPECT_LT(reports[step].law_residual, 1e-10) << "step " << step;
+    }
+}
+
+TEST(ContactSolvers, InteriorPointOnTwoThreadsGivesOneThreadsSolution)
+{
+  // A hexagonal stack 700 discs wide (three rows, about 6300 contacts): with two threads
+  // its Newton matrix is factorised in two halves; both reach the target and the steps'
+  // velocities are one thread's.
+  const ParticleSystem s = hexagonal_stack(70000, 2, 700);
+  SolverParameters prm;
+  prm.method          = SolverParameters::Method::interior_point;
+  prm.residual_target = 1e-8; // the converged target
+  std::vector<ParticleSystem> runs(2, s);
+  std::vector<SolveReport>    last(2);
+  for (const unsigned int threads : {1u, 2u})
+    {
+      prm.threads = threads;
+      MoreauJean mj(0.5, ContactLaw{}, prm, 0.1 * radius);
+      for (int step = 0; step < 3; ++step)
+        last[threads - 1] = mj.step(runs[threads - 1], h).solver;
+      if (threads == 2)
+        {
+          std::vector<Contact> contacts = mj.contacts();
+          ASSERT_GT(contacts.size(), 4000u);
+          const FrictionlessProblem lcp(contacts, BodyState::of(runs[1]), true);
+          EXPECT_TRUE(BisectedCholesky(lcp.scaled().A, true).split());
+        }
+    }
+  double difference = 0, scale = 0;
+  for (std::size_t b = 0; b < s.bodies.size(); ++b)
+    {
+      difference = std::max(difference, (runs[0].bodies[b].velocity - runs[1].bodies[b].velocity).norm());
+      scale      = std::max(scale, runs[0].bodies[b].velocity.norm());
+    }
+  EXPECT_LT(difference, 1e-6 * scale);
+  for (const SolveReport &r : last)
+    {
+      EXPECT_TRUE(r.converged);
+      EXPECT_LT(r.law_residual, 1e-8);
     }
 }

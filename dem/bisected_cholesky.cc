@@ -1,0 +1,241 @@
+#include "dem/bisected_cholesky.h"
+
+#include <deal.II/base/parallel.h>
+
+#include <Eigen/CholmodSupport>
+
+#include <algorithm>
+
+namespace tribo::dem
+{
+  namespace
+  {
+    using ColumnMap = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int>>;
+
+    /// CHOLMOD's simplicial LL^T factor as an Eigen column-major matrix (no copy; rows
+    /// ascending in each column, the diagonal first).
+    ColumnMap view(const cholmod_factor *L)
+    {
+      const auto n = Eigen::Index(L->n);
+      return ColumnMap(n, n, static_cast<const int *>(L->p)[n], static_cast<const int *>(L->p),
+                       static_cast<const int *>(L->i), static_cast<const double *>(L->x),
+                       static_cast<const int *>(L->nz));
+    }
+  } // namespace
+
+  BisectedCholesky::BisectedCholesky(const Eigen::SparseMatrix<double> &A, bool concurrent)
+  {
+    for (Side &s : sides)
+      {
+        cholmod_start(&s.common);
+        s.common.print      = 0;
+        s.common.supernodal = CHOLMOD_SIMPLICIAL;
+        s.common.final_ll   = 1;
+      }
+    const Eigen::Index n = A.rows();
+    if (!concurrent || n < min_rows)
+      return;
+    Eigen::SparseMatrix<double> pattern = A; // cholmod_bisect reads the lower triangle
+    cholmod_sparse              graph   = Eigen::viewAsCholmod(pattern);
+    graph.stype                         = -1;
+    std::vector<int> part(n);
+    const long       m = cholmod_bisect(&graph, nullptr, 0, 0, part.data(), &sides[0].common);
+    if (m <= 0 || m > max_separator || double(m) > max_separator_fraction * double(n) ||
+        sides[0].common.status != CHOLMOD_OK)
+      return;
+    std::vector<int> separator_index(n, -1);
+    for (Eigen::Index j = 0; j < n; ++j)
+      if (part[j] == 2)
+        {
+          separator_index[j] = int(separator.size());
+          separator.push_back(int(j));
+        }
+    K_ss = Eigen::MatrixXd::Zero(m, m);
+    for (long a = 0; a < m; ++a)
+      for (Eigen::SparseMatrix<double>::InnerIterator e(A, separator[a]); e; ++e)
+        if (separator_index[e.row()] >= 0)
+          K_ss(separator_index[e.row()], a) = e.value();
+    for (int i = 0; i < 2; ++i)
+      {
+        Side            &s = sides[i];
+        std::vector<int> local(n, -1);
+        for (Eigen::Index j = 0; j < n; ++j)
+          if (part[j] == i)
+            {
+              local[j] = int(s.rows.size());
+              s.rows.push_back(int(j));
+            }
+        s.own = Eigen::Index(s.rows.size());
+        if (s.own == 0)
+          return;
+        for (const int j : separator)
+          {
+            local[j] = int(s.rows.size());
+            s.rows.push_back(j);
+          }
+        // E_i column by column in local order; a column's few entries sorted by local row.
+        const auto size = Eigen::Index(s.rows.size());
+        std::vector<int>    start(size + 1, 0), index;
+        std::vector<double> value;
+        std::vector<std::pair<int, double>> column;
+        for (Eigen::Index q = 0; q < size; ++q)
+          {
+            column.clear();
+            for (Eigen::SparseMatrix<double>::InnerIterator e(A, s.rows[q]); e; ++e)
+              if (local[e.row()] >= 0)
+                column.emplace_back(local[e.row()], e.value());
+            std::sort(column.begin(), column.end());
+            for (const auto &[r, a] : column)
+              {
+                index.push_back(r);
+                value.push_back(a);
+              }
+            start[q + 1] = int(index.size());
+          }
+        s.E = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int>>(
+          size, size, start[size], start.data(), index.data(), value.data());
+        s.diagonal.resize(size);
+        s.unit.resize(size);
+        for (Eigen::Index q = 0; q < size; ++q)
+          {
+            s.diagonal[q] = &s.E.coeffRef(q, q);
+            s.unit[q]     = *s.diagonal[q];
+          }
+        // CAMD with the separator as the last constraint set, then the analysis with that
+        // order as given (no postordering, which could interleave the separator).
+        std::vector<int> member(size, 0), order(size);
+        std::fill(member.begin() + s.own, member.end(), 1);
+        cholmod_sparse e = Eigen::viewAsCholmod(s.E);
+        e.stype          = -1;
+        if (!cholmod_camd(&e, nullptr, 0, member.data(), order.data(), &s.common))
+          return;
+        s.common.nmethods           = 1;
+        s.common.method[0].ordering = CHOLMOD_GIVEN;
+        s.common.postorder          = 0;
+        s.L = cholmod_analyze_p(&e, order.data(), nullptr, 0, &s.common);
+        if (!s.L)
+          return;
+        const int *perm = static_cast<const int *>(s.L->Perm);
+        s.permutation.assign(perm, perm + size);
+        s.separator_at.resize(m);
+        for (long q = 0; q < m; ++q)
+          {
+            if (s.permutation[s.own + q] < s.own)
+              return; // the separator did not end last
+            s.separator_at[q] = s.permutation[s.own + q] - int(s.own);
+          }
+        s.Ls.resize(m, m);
+        s.LsLsT.resize(m, m);
+        s.work.resize(size);
+      }
+    usable = true;
+  }
+
+  BisectedCholesky::~BisectedCholesky()
+  {
+    for (Side &s : sides)
+      {
+        if (s.L)
+          cholmod_free_factor(&s.L, &s.common);
+        for (cholmod_dense **d : {&s.X, &s.Y, &s.E_work})
+          if (*d)
+            cholmod_free_dense(d, &s.common);
+        cholmod_finish(&s.common);
+      }
+  }
+
+  template <typename F>
+  void BisectedCholesky::for_both_sides(const F &f) const
+  {
+    dealii::parallel::apply_to_subranges(0, 2, [&](int first, int last) {
+      for (int i = first; i < last; ++i)
+        f(i);
+    }, 1);
+  }
+
+  void BisectedCholesky::triangular(const Side &s, int system) const
+  {
+    cholmod_dense b = Eigen::viewAsCholmod(s.work);
+    cholmod_solve2(system, s.L, &b, nullptr, &s.X, nullptr, &s.Y, &s.E_work, &s.common);
+    s.work = Eigen::Map<const Eigen::VectorXd>(static_cast<const double *>(s.X->x), s.work.size());
+  }
+
+  bool BisectedCholesky::factorise(const Eigen::VectorXd &shift)
+  {
+    const auto m = Eigen::Index(separator.size());
+    bool       ok[2];
+    for_both_sides([&](int i) {
+      Side &s = sides[i];
+      for (Eigen::Index q = 0; q < Eigen::Index(s.rows.size()); ++q)
+        *s.diagonal[q] = s.unit[q] + shift[s.rows[q]];
+      cholmod_sparse e = Eigen::viewAsCholmod(s.E);
+      e.stype          = -1;
+      cholmod_factorize(&e, s.L, &s.common);
+      ok[i] = s.common.status == CHOLMOD_OK && s.L->minor == s.L->n && s.L->is_ll;
+      if (!ok[i])
+        return;
+      // L_si: the trailing m x m block of the factor.
+      const ColumnMap L = view(s.L);
+      s.Ls.setZero();
+      for (Eigen::Index c = 0; c < m; ++c)
+        for (ColumnMap::InnerIterator a(L, s.own + c); a; ++a)
+          s.Ls(a.row() - s.own, c) = a.value();
+      s.LsLsT.setZero();
+      s.LsLsT.selfadjointView<Eigen::Lower>().rankUpdate(s.Ls);
+    });
+    if (!ok[0] || !ok[1])
+      return false;
+    // S = L_s0 L_s0^T + L_s1 L_s1^T - K_ss in the separator's order.
+    Eigen::MatrixXd S = -K_ss;
+    for (Eigen::Index a = 0; a < m; ++a)
+      S(a, a) -= shift[separator[a]];
+    for (const Side &s : sides)
+      for (Eigen::Index c = 0; c < m; ++c)
+        for (Eigen::Index a = c; a < m; ++a)
+          {
+            S(s.separator_at[a], s.separator_at[c]) += s.LsLsT(a, c);
+            if (a != c)
+              S(s.separator_at[c], s.separator_at[a]) += s.LsLsT(a, c);
+          }
+    schur.compute(S);
+    return schur.info() == Eigen::Success;
+  }
+
+  Eigen::VectorXd BisectedCholesky::solve(const Eigen::VectorXd &v) const
+  {
+    const auto      m = Eigen::Index(separator.size());
+    Eigen::VectorXd t[2] = {Eigen::VectorXd(m), Eigen::VectorXd(m)};
+    // t_i = K_si K_ii^-1 v_i = -L_si c_i.
+    for_both_sides([&](int i) {
+      const Side      &s = sides[i];
+      Eigen::VectorXd &y = s.work;
+      for (Eigen::Index q = 0; q < y.size(); ++q)
+        y[q] = s.permutation[q] < s.own ? v[s.rows[s.permutation[q]]] : 0.0;
+      triangular(s, CHOLMOD_L);
+      const Eigen::VectorXd u = -(s.Ls.triangularView<Eigen::Lower>() * y.tail(m));
+      for (Eigen::Index q = 0; q < m; ++q)
+        t[i][s.separator_at[q]] = u[q];
+    });
+    Eigen::VectorXd x(v.size()), r(m);
+    for (Eigen::Index a = 0; a < m; ++a)
+      r[a] = v[separator[a]] - t[0][a] - t[1][a];
+    const Eigen::VectorXd x_s = schur.solve(r);
+    for (Eigen::Index a = 0; a < m; ++a)
+      x[separator[a]] = x_s[a];
+    // x_i = K_ii^-1 (v_i - K_is x_s) = L_ii^-T (a_i - W_i x_s): the backward solve of
+    // L_i^T y = [a_i; L_si^T x_s], whose last m rows give y = x_s (W_i^T is the factor's
+    // block below L_ii).
+    for_both_sides([&](int i) {
+      const Side      &s = sides[i];
+      Eigen::VectorXd &y = s.work; // [a_i; c_i] from the forward solve
+      Eigen::VectorXd  x_perm(m);
+      for (Eigen::Index q = 0; q < m; ++q)
+        x_perm[q] = x_s[s.separator_at[q]];
+      y.tail(m) = s.Ls.transpose().triangularView<Eigen::Upper>() * x_perm;
+      triangular(s, CHOLMOD_Lt);
+      for (Eigen::Index q = 0; q < s.own; ++q)
+        x[s.rows[s.permutation[q]]] = y[q];
+    });
+    return x;
+  }
+} // namespace tribo::dem

@@ -1,0 +1,68 @@
+// The two-way split Cholesky factorisation (dem/bisected_cholesky.h) against the whole
+// factor (the interior point on two threads: tests/unit/test_contact_solvers.cc).
+#include "dem/bisected_cholesky.h"
+
+#include <Eigen/SparseCholesky>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace tribo::dem;
+
+namespace
+{
+  /// The graph Laplacian of a strip @p length x @p width, periodic along its length (the
+  /// shear cell's shape), plus 1e-3 on the diagonal: symmetric positive definite.
+  Eigen::SparseMatrix<double> periodic_strip(int length, int width)
+  {
+    std::vector<Eigen::Triplet<double>> t;
+    auto node = [&](int i, int j) { return ((i + length) % length) * width + j; };
+    for (int i = 0; i < length; ++i)
+      for (int j = 0; j < width; ++j)
+        {
+          double degree = 1e-3;
+          for (const auto &[di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}})
+            if (j + dj >= 0 && j + dj < width)
+              {
+                t.emplace_back(node(i + di, j + dj), node(i, j), -1.0);
+                degree += 1;
+              }
+          t.emplace_back(node(i, j), node(i, j), degree);
+        }
+    Eigen::SparseMatrix<double> A(length * width, length * width);
+    A.setFromTriplets(t.begin(), t.end());
+    return A;
+  }
+} // namespace
+
+TEST(BisectedCholesky, SolvesAPeriodicStripAsTheWholeFactorDoes)
+{
+  const Eigen::SparseMatrix<double> A = periodic_strip(400, 12); // 4800 rows
+  BisectedCholesky                  halves(A, true);
+  ASSERT_TRUE(halves.split());
+  // The interior point's shifts span many decades, up to the crossover's 1e20 on open rows.
+  Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0).array().sin();
+  for (const double spread : {0.0, 10.0, 28.0})
+    {
+      Eigen::VectorXd shift(A.rows());
+      for (Eigen::Index j = 0; j < A.rows(); ++j)
+        shift[j] = spread == 0 ? 0.0 : std::pow(10.0, -8 + spread * double((j * 7919) % 97) / 96);
+      ASSERT_TRUE(halves.factorise(shift)) << spread;
+      Eigen::SparseMatrix<double> K = A;
+      for (Eigen::Index j = 0; j < A.rows(); ++j)
+        K.coeffRef(j, j) += shift[j];
+      const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> whole(K);
+      const Eigen::VectorXd x = halves.solve(v), x_whole = whole.solve(v);
+      EXPECT_LT((K * x - v).norm(), 1e-12 * v.norm()) << spread;
+      EXPECT_LT((x - x_whole).norm(), 1e-10 * x_whole.norm()) << spread;
+    }
+}
+
+TEST(BisectedCholesky, SmallOrOneThreadProblemsAreFactorisedWhole)
+{
+  EXPECT_FALSE(BisectedCholesky(periodic_strip(300, 12), true).split()); // 3600 < min_rows
+  EXPECT_FALSE(BisectedCholesky(periodic_strip(400, 12), false).split());
+  // A square grid's separator (about 70 rows) is within the limits; a denser graph's is not.
+  EXPECT_TRUE(BisectedCholesky(periodic_strip(70, 70), true).split());
+}
