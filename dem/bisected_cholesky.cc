@@ -55,79 +55,83 @@ namespace tribo::dem
       for (Eigen::SparseMatrix<double>::InnerIterator e(A, separator[a]); e; ++e)
         if (separator_index[e.row()] >= 0)
           K_ss(separator_index[e.row()], a) = e.value();
-    for (int i = 0; i < 2; ++i)
-      {
-        Side            &s = sides[i];
-        std::vector<int> local(n, -1);
-        for (Eigen::Index j = 0; j < n; ++j)
-          if (part[j] == i)
-            {
-              local[j] = int(s.rows.size());
-              s.rows.push_back(int(j));
-            }
-        s.own = Eigen::Index(s.rows.size());
-        if (s.own == 0)
-          return;
-        for (const int j : separator)
+    // Each side's block, ordering and analysis, the two concurrently.
+    bool analysed[2] = {false, false};
+    for_both_sides([&](int i) {
+      Side            &s = sides[i];
+      std::vector<int> local(n, -1);
+      for (Eigen::Index j = 0; j < n; ++j)
+        if (part[j] == i)
           {
             local[j] = int(s.rows.size());
-            s.rows.push_back(j);
+            s.rows.push_back(int(j));
           }
-        // E_i column by column in local order; a column's few entries sorted by local row.
-        const auto size = Eigen::Index(s.rows.size());
-        std::vector<int>    start(size + 1, 0), index;
-        std::vector<double> value;
-        std::vector<std::pair<int, double>> column;
-        for (Eigen::Index q = 0; q < size; ++q)
-          {
-            column.clear();
-            for (Eigen::SparseMatrix<double>::InnerIterator e(A, s.rows[q]); e; ++e)
-              if (local[e.row()] >= 0)
-                column.emplace_back(local[e.row()], e.value());
-            std::sort(column.begin(), column.end());
-            for (const auto &[r, a] : column)
-              {
-                index.push_back(r);
-                value.push_back(a);
-              }
-            start[q + 1] = int(index.size());
-          }
-        s.E = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int>>(
-          size, size, start[size], start.data(), index.data(), value.data());
-        s.diagonal.resize(size);
-        s.unit.resize(size);
-        for (Eigen::Index q = 0; q < size; ++q)
-          {
-            s.diagonal[q] = &s.E.coeffRef(q, q);
-            s.unit[q]     = *s.diagonal[q];
-          }
-        // CAMD with the separator as the last constraint set, then the analysis with that
-        // order as given (no postordering, which could interleave the separator).
-        std::vector<int> member(size, 0), order(size);
-        std::fill(member.begin() + s.own, member.end(), 1);
-        cholmod_sparse e = Eigen::viewAsCholmod(s.E);
-        e.stype          = -1;
-        if (!cholmod_camd(&e, nullptr, 0, member.data(), order.data(), &s.common))
-          return;
-        s.common.nmethods           = 1;
-        s.common.method[0].ordering = CHOLMOD_GIVEN;
-        s.common.postorder          = 0;
-        s.L = cholmod_analyze_p(&e, order.data(), nullptr, 0, &s.common);
-        if (!s.L)
-          return;
-        const int *perm = static_cast<const int *>(s.L->Perm);
-        s.permutation.assign(perm, perm + size);
-        s.separator_at.resize(m);
-        for (long q = 0; q < m; ++q)
-          {
-            if (s.permutation[s.own + q] < s.own)
-              return; // the separator did not end last
-            s.separator_at[q] = s.permutation[s.own + q] - int(s.own);
-          }
-        s.Ls.resize(m, m);
-        s.LsLsT.resize(m, m);
-        s.work.resize(size);
-      }
+      s.own = Eigen::Index(s.rows.size());
+      if (s.own == 0)
+        return; // analysed[i] stays false
+      for (const int j : separator)
+        {
+          local[j] = int(s.rows.size());
+          s.rows.push_back(j);
+        }
+      // E_i column by column in local order; a column's few entries sorted by local row.
+      const auto size = Eigen::Index(s.rows.size());
+      std::vector<int>    start(size + 1, 0), index;
+      std::vector<double> value;
+      std::vector<std::pair<int, double>> column;
+      for (Eigen::Index q = 0; q < size; ++q)
+        {
+          column.clear();
+          for (Eigen::SparseMatrix<double>::InnerIterator e(A, s.rows[q]); e; ++e)
+            if (local[e.row()] >= 0)
+              column.emplace_back(local[e.row()], e.value());
+          std::sort(column.begin(), column.end());
+          for (const auto &[r, a] : column)
+            {
+              index.push_back(r);
+              value.push_back(a);
+            }
+          start[q + 1] = int(index.size());
+        }
+      s.E = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int>>(
+        size, size, start[size], start.data(), index.data(), value.data());
+      s.diagonal.resize(size);
+      s.unit.resize(size);
+      for (Eigen::Index q = 0; q < size; ++q)
+        {
+          s.diagonal[q] = &s.E.coeffRef(q, q);
+          s.unit[q]     = *s.diagonal[q];
+        }
+      // CAMD with the separator as the last constraint set, then the analysis with that
+      // order as given (no postordering, which could interleave the separator).
+      std::vector<int> member(size, 0), order(size);
+      std::fill(member.begin() + s.own, member.end(), 1);
+      cholmod_sparse e = Eigen::viewAsCholmod(s.E);
+      e.stype          = -1;
+      if (!cholmod_camd(&e, nullptr, 0, member.data(), order.data(), &s.common))
+        return; // analysed[i] stays false
+      s.common.nmethods           = 1;
+      s.common.method[0].ordering = CHOLMOD_GIVEN;
+      s.common.postorder          = 0;
+      s.L = cholmod_analyze_p(&e, order.data(), nullptr, 0, &s.common);
+      if (!s.L)
+        return; // analysed[i] stays false
+      const int *perm = static_cast<const int *>(s.L->Perm);
+      s.permutation.assign(perm, perm + size);
+      s.separator_at.resize(m);
+      for (long q = 0; q < m; ++q)
+        {
+          if (s.permutation[s.own + q] < s.own)
+            return; // the separator did not end last: analysed[i] stays false
+          s.separator_at[q] = s.permutation[s.own + q] - int(s.own);
+        }
+      s.Ls.resize(m, m);
+      s.LsLsT.resize(m, m);
+      s.work.resize(size);
+      analysed[i] = true;
+    });
+    if (!analysed[0] || !analysed[1])
+      return;
     usable = true;
   }
 
