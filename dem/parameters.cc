@@ -122,7 +122,10 @@ namespace tribo::dem
                       "contacts (rows of cells, bottom to top) into 2T bands and solves the even bands "
                       "concurrently, then the odd ones: a Gauss-Seidel sweep in that band order, the "
                       "same result on any number of cores. Needs Contact order = fixed. The contact "
-                      "detection also runs in T threads (the same contacts whatever T).");
+                      "detection also runs in T threads (the same contacts whatever T). APGD, APGS: "
+                      "their passes over both cores, the same bits. Interior point: from 4000 "
+                      "contacts its Newton matrix is factorised in two halves at once (its rounding "
+                      "then differs from one thread's).");
     prm.declare_entry("Gap tolerance", "0", Double(),
                       "NLGS: extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
                       "0: off, the established code's norms only): every contact's gap violation "
