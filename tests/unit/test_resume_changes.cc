@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -36,7 +38,10 @@ namespace
       prm.declare_entry("Pressure", "1e8", dealii::Patterns::Double(0));
       prm.declare_entry("New entry", "0.5", dealii::Patterns::Double(0));
       prm.leave_subsection();
-      const std::string name = ::testing::TempDir() + "resume_case.prm";
+      // One file per test and process: ctest runs these tests concurrently.
+      const std::string name = ::testing::TempDir() + "resume_case_" +
+                               ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
+                               std::to_string(::getpid()) + ".prm";
       std::ofstream(name) << body;
       file.parse(name);
       std::remove(name.c_str());
