@@ -1,8 +1,13 @@
 #include "dem/bisected_cholesky.h"
 
+#include "dem/delassus.h"
+#include "dem/nlgs.h"
+
 #include <deal.II/base/parallel.h>
 
 #include <Eigen/CholmodSupport>
+
+#include <metis.h>
 
 #include <algorithm>
 
@@ -23,7 +28,81 @@ namespace tribo::dem
     }
   } // namespace
 
-  BisectedCholesky::BisectedCholesky(const Eigen::SparseMatrix<double> &A, bool concurrent)
+  std::vector<int> grain_bisection(const std::vector<Contact> &contacts, const BodyState &state)
+  {
+    const std::size_t nb = state.inverse_mass.size();
+    std::vector<int>  count(nb, 0);
+    for (const Contact &c : contacts)
+      {
+        if (c.on_boundary())
+          return {};
+        ++count[c.body[0]];
+        ++count[c.body[1]];
+      }
+    // The bodies that couple contacts in A', numbered 0 .. vertices - 1.
+    const unsigned int limit = LowRankBodies{}.contact_limit;
+    std::vector<idx_t> vertex(nb, -1), weight;
+    for (std::size_t b = 0; b < nb; ++b)
+      {
+        const auto &im = state.inverse_mass[b];
+        if (count[b] > 0 && count[b] <= int(limit) && (im[0] > 0 || im[1] > 0 || im[2] > 0))
+          {
+            vertex[b] = idx_t(weight.size());
+            weight.push_back(count[b]);
+          }
+      }
+    idx_t vertices = idx_t(weight.size());
+    if (vertices < 2)
+      return {};
+    // Adjacency without repeats (a clump may touch a grain twice): the repeats as weights.
+    std::vector<std::vector<std::pair<idx_t, idx_t>>> neighbours(vertices);
+    for (const Contact &c : contacts)
+      {
+        const idx_t a = vertex[c.body[0]], b = vertex[c.body[1]];
+        if (a >= 0 && b >= 0 && a != b)
+          {
+            neighbours[a].push_back({b, 1});
+            neighbours[b].push_back({a, 1});
+          }
+      }
+    std::vector<idx_t> start{0}, adjacent, multiplicity;
+    for (auto &list : neighbours)
+      {
+        std::sort(list.begin(), list.end());
+        for (std::size_t k = 0; k < list.size(); ++k)
+          if (k > 0 && list[k].first == list[k - 1].first)
+            ++multiplicity.back();
+          else
+            {
+              adjacent.push_back(list[k].first);
+              multiplicity.push_back(1);
+            }
+        start.push_back(idx_t(adjacent.size()));
+      }
+    idx_t options[METIS_NOPTIONS];
+    METIS_SetDefaultOptions(options);
+    idx_t              constraints = 1, parts = 2, cut = 0;
+    std::vector<idx_t> side(vertices);
+    if (METIS_PartGraphRecursive(&vertices, &constraints, start.data(), adjacent.data(), weight.data(),
+                                 nullptr, multiplicity.data(), &parts, nullptr, nullptr, options, &cut,
+                                 side.data()) != METIS_OK)
+      return {};
+    std::vector<int> partition(contacts.size());
+    for (std::size_t i = 0; i < contacts.size(); ++i)
+      {
+        const idx_t a = vertex[contacts[i].body[0]], b = vertex[contacts[i].body[1]];
+        if (a >= 0 && b >= 0)
+          partition[i] = side[a] == side[b] ? int(side[a]) : 2;
+        else if (a >= 0 || b >= 0)
+          partition[i] = int(side[a >= 0 ? a : b]);
+        else
+          partition[i] = 0; // couples nothing in A' (both bodies walls or imposed)
+      }
+    return partition;
+  }
+
+  BisectedCholesky::BisectedCholesky(const Eigen::SparseMatrix<double> &A, bool concurrent,
+                                     const std::vector<int> &partition)
   {
     for (Side &s : sides)
       {
@@ -35,13 +114,21 @@ namespace tribo::dem
     const Eigen::Index n = A.rows();
     if (!concurrent || n < min_rows)
       return;
-    Eigen::SparseMatrix<double> pattern = A; // cholmod_bisect reads the lower triangle
-    cholmod_sparse              graph   = Eigen::viewAsCholmod(pattern);
-    graph.stype                         = -1;
-    std::vector<int> part(n);
-    const long       m = cholmod_bisect(&graph, nullptr, 0, 0, part.data(), &sides[0].common);
-    if (m <= 0 || m > max_separator || double(m) > max_separator_fraction * double(n) ||
-        sides[0].common.status != CHOLMOD_OK)
+    std::vector<int> part = partition;
+    if (part.empty())
+      {
+        Eigen::SparseMatrix<double> pattern = A; // cholmod_bisect reads the lower triangle
+        cholmod_sparse              graph   = Eigen::viewAsCholmod(pattern);
+        graph.stype                         = -1;
+        part.resize(n);
+        cholmod_bisect(&graph, nullptr, 0, 0, part.data(), &sides[0].common);
+        if (sides[0].common.status != CHOLMOD_OK)
+          return;
+      }
+    if (Eigen::Index(part.size()) != n)
+      return;
+    const auto m = Eigen::Index(std::count(part.begin(), part.end(), 2));
+    if (m <= 0 || m > max_separator || double(m) > max_separator_fraction * double(n))
       return;
     std::vector<int> separator_index(n, -1);
     for (Eigen::Index j = 0; j < n; ++j)

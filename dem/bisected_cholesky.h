@@ -2,8 +2,9 @@
 /// @file A sparse Cholesky factorisation of K = A + diag(shift) in two halves that CHOLMOD
 /// factorises concurrently: one level of nested dissection by hand.
 ///
-/// METIS (through cholmod_bisect) splits K's graph into two sides 0, 1 that share no entry
-/// and a separator s. Each side's extended block
+/// A partition of K's rows into two sides 0, 1 that share no entry and a separator s comes
+/// either from grain_bisection() (the contacts across an edge cut of the grains' contact
+/// graph) or from METIS's node separator of K's graph itself (cholmod_bisect). Each side's extended block
 ///     E_i = [K_ii  K_is]
 ///           [K_si  K_ss]
 /// is a principal submatrix of K, so it is positive definite; CHOLMOD factorises it
@@ -36,6 +37,22 @@
 
 namespace tribo::dem
 {
+  struct Contact;
+  struct BodyState;
+
+  /// The rows of a frictionless problem of @p contacts (dem/frictionless_problem.h, walls as
+  /// low-rank columns) split in two: METIS cuts the graph of the bodies that couple contacts
+  /// in A' (bodies with a free dof and at most LowRankBodies::contact_limit contacts; an edge
+  /// per contact, a body weighted by its contacts) into two halves of about as many
+  /// contacts; a contact between two bodies of one half is in that half (0 or 1), one
+  /// across the cut is in the separator (2), one with a single such body goes with it.
+  /// Contacts of the two halves share no body, so K has no entry between them. As many
+  /// rows as METIS's node separator of K itself (105-115 against about 110 at 3800 and
+  /// 16 000 grains) from a graph of a tenth the edges: 4-7 ms less per step at 3800 grains
+  /// (docs/performance.md). Empty with a contact on a boundary body (its compliance couples
+  /// every half-disc contact).
+  std::vector<int> grain_bisection(const std::vector<Contact> &contacts, const BodyState &state);
+
   class BisectedCholesky
   {
   public:
@@ -44,7 +61,10 @@ namespace tribo::dem
     /// small (more than max_separator_fraction of the rows or more than max_separator rows)
     /// or when A has fewer than min_rows rows: then the object holds nothing and must not be
     /// used.
-    explicit BisectedCholesky(const Eigen::SparseMatrix<double> &A, bool concurrent);
+    /// @p partition: 0, 1 or 2 (separator) per row, e.g. from grain_bisection(); empty:
+    /// METIS's node separator of A's graph.
+    BisectedCholesky(const Eigen::SparseMatrix<double> &A, bool concurrent,
+                     const std::vector<int> &partition = {});
     ~BisectedCholesky();
     BisectedCholesky(const BisectedCholesky &)            = delete;
     BisectedCholesky &operator=(const BisectedCholesky &) = delete;

@@ -31,7 +31,10 @@ namespace tribo::dem
   class ShiftedFactorisation
   {
   public:
-    ShiftedFactorisation(const FrictionlessProblem::Scaled &p, unsigned int threads);
+    /// @p partition: the rows' halves for two threads (grain_bisection(); empty: METIS's
+    /// node separator of K's graph).
+    ShiftedFactorisation(const FrictionlessProblem::Scaled &p, unsigned int threads,
+                         const std::vector<int> &partition = {});
     /// Factorise K with this @p barrier (dimensionless, >= 0, one per contact); false if
     /// CHOLMOD fails (K numerically not positive definite).
     bool factorise(const Eigen::VectorXd &barrier);

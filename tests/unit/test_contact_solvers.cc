@@ -491,8 +491,30 @@ TEST(ContactSolvers, InteriorPointOnTwoThreadsGivesOneThreadsSolution)
         {
           std::vector<Contact> contacts = mj.contacts();
           ASSERT_GT(contacts.size(), 4000u);
-          const FrictionlessProblem lcp(contacts, BodyState::of(runs[1]), true);
+          const BodyState           state = BodyState::of(runs[1]);
+          const FrictionlessProblem lcp(contacts, state, true);
           EXPECT_TRUE(BisectedCholesky(lcp.scaled().A, true).split());
+          // The grains' edge cut: halves of about as many contacts, sharing no grain (the
+          // walls, bodies 0 and the last, couple nothing in A'), a small separator.
+          const std::vector<int> part = grain_bisection(contacts, state);
+          ASSERT_EQ(part.size(), contacts.size());
+          std::vector<int> side_of_body(runs[1].bodies.size(), -1), count(3, 0);
+          const unsigned int upper_wall = runs[1].bodies.size() - 1;
+          for (std::size_t i = 0; i < contacts.size(); ++i)
+            {
+              ++count[part[i]];
+              if (part[i] == 2)
+                continue;
+              for (const unsigned int b : contacts[i].body)
+                if (b != 0 && b != upper_wall)
+                  {
+                    EXPECT_NE(side_of_body[b], 1 - part[i]) << "body " << b;
+                    side_of_body[b] = part[i];
+                  }
+            }
+          EXPECT_LT(std::abs(count[0] - count[1]), 0.05 * contacts.size());
+          EXPECT_LT(count[2], 0.02 * contacts.size());
+          EXPECT_TRUE(BisectedCholesky(lcp.scaled().A, true, part).split());
         }
     }
   double difference = 0, scale = 0;
