@@ -101,8 +101,7 @@ namespace tribo::dem
     return partition;
   }
 
-  BisectedCholesky::BisectedCholesky(const Eigen::SparseMatrix<double> &A, bool concurrent,
-                                     const std::vector<int> &partition)
+  BisectedCholesky::BisectedCholesky(const Eigen::SparseMatrix<double> &A, const std::vector<int> &part)
   {
     for (Side &s : sides)
       {
@@ -112,20 +111,7 @@ namespace tribo::dem
         s.common.final_ll   = 1;
       }
     const Eigen::Index n = A.rows();
-    if (!concurrent || n < min_rows)
-      return;
-    std::vector<int> part = partition;
-    if (part.empty())
-      {
-        Eigen::SparseMatrix<double> pattern = A; // cholmod_bisect reads the lower triangle
-        cholmod_sparse              graph   = Eigen::viewAsCholmod(pattern);
-        graph.stype                         = -1;
-        part.resize(n);
-        cholmod_bisect(&graph, nullptr, 0, 0, part.data(), &sides[0].common);
-        if (sides[0].common.status != CHOLMOD_OK)
-          return;
-      }
-    if (Eigen::Index(part.size()) != n)
+    if (n < min_rows || Eigen::Index(part.size()) != n)
       return;
     const auto m = Eigen::Index(std::count(part.begin(), part.end(), 2));
     if (m <= 0 || m > max_separator || double(m) > max_separator_fraction * double(n))

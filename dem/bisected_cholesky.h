@@ -3,8 +3,8 @@
 /// factorises concurrently: one level of nested dissection by hand.
 ///
 /// A partition of K's rows into two sides 0, 1 that share no entry and a separator s comes
-/// either from grain_bisection() (the contacts across an edge cut of the grains' contact
-/// graph) or from METIS's node separator of K's graph itself (cholmod_bisect). Each side's extended block
+/// from grain_bisection() (the contacts across an edge cut of the grains' contact graph).
+/// Each side's extended block
 ///     E_i = [K_ii  K_is]
 ///           [K_si  K_ss]
 /// is a principal submatrix of K, so it is positive definite; CHOLMOD factorises it
@@ -22,10 +22,9 @@
 ///         (the backward solve of L_i^T y = [a_i; L_si^T x_s], whose last rows are x_s),
 /// two triangular solves per side, as many as the whole factor's solve.
 /// The two sides' factorisations and solves run concurrently (on one core the split costs
-/// about 10 % more than the whole factor: METIS's bisection, about 5 ms per step at 4000
-/// grains, and the separator's dense work; so it is only made for two threads). Each side
-/// costs about half of K's factorisation (1.34e7 flops for the 9167-contact K of the 4000-grain cell: 6.8e6 and
-/// 6.6e6; docs/performance.md).
+/// about 10 % more than the whole factor, so the interior point makes it only for two
+/// threads). Each side costs about half of K's factorisation (1.34e7 flops for the
+/// 9167-contact K of the 4000-grain cell: 6.8e6 and 6.6e6; docs/performance.md).
 
 #include <Eigen/Core>
 #include <Eigen/Dense>
@@ -56,15 +55,13 @@ namespace tribo::dem
   class BisectedCholesky
   {
   public:
-    /// With @p concurrent, bisect the graph of @p A (symmetric, both triangles stored) and
-    /// analyse both sides. split() is false without @p concurrent, when the separator is not
-    /// small (more than max_separator_fraction of the rows or more than max_separator rows)
-    /// or when A has fewer than min_rows rows: then the object holds nothing and must not be
-    /// used.
-    /// @p partition: 0, 1 or 2 (separator) per row, e.g. from grain_bisection(); empty:
-    /// METIS's node separator of A's graph.
-    BisectedCholesky(const Eigen::SparseMatrix<double> &A, bool concurrent,
-                     const std::vector<int> &partition = {});
+    /// Analyse both sides of @p A (symmetric, both triangles stored) as @p partition splits
+    /// its rows: 0, 1 or 2 (separator) per row, no entry of A between sides 0 and 1 (the
+    /// caller's guarantee, e.g. grain_bisection()). split() is false for an empty
+    /// partition, when A has fewer than min_rows rows or when the separator is not small
+    /// (more than max_separator rows or max_separator_fraction of them): then the object
+    /// holds nothing and must not be used.
+    BisectedCholesky(const Eigen::SparseMatrix<double> &A, const std::vector<int> &partition);
     ~BisectedCholesky();
     BisectedCholesky(const BisectedCholesky &)            = delete;
     BisectedCholesky &operator=(const BisectedCholesky &) = delete;
@@ -112,7 +109,6 @@ namespace tribo::dem
     Side                        sides[2];
     std::vector<int>            separator; ///< rows of K, ascending
     Eigen::MatrixXd             K_ss;      ///< A on the separator (dense)
-    Eigen::VectorXd             shift_ss;
     Eigen::LLT<Eigen::MatrixXd> schur;
   };
 } // namespace tribo::dem

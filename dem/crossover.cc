@@ -5,10 +5,10 @@
 
 namespace tribo::dem
 {
-  ShiftedFactorisation::ShiftedFactorisation(const FrictionlessProblem::Scaled &problem, unsigned int threads,
+  ShiftedFactorisation::ShiftedFactorisation(const FrictionlessProblem::Scaled &problem,
                                              const std::vector<int> &partition)
     : p(problem), K(problem.A), diagonal(problem.A.rows()), unit(problem.A.rows()),
-      barrier(Eigen::VectorXd::Zero(problem.A.rows())), halves(problem.A, threads > 1, partition)
+      barrier(Eigen::VectorXd::Zero(problem.A.rows())), halves(problem.A, partition)
   {
     if (halves.split())
       return;

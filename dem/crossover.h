@@ -20,8 +20,8 @@ namespace tribo::dem
 {
   /// K = A' + diag(barrier) + U'U'^T of a scaled problem, factorised by CHOLMOD (simplicial
   /// LL^T: 1.7 times faster than its supernodal one with Debian's reference BLAS on the
-  /// 3800-grain benchmark, docs/performance.md); with @p threads > 1, from 4000 contacts and
-  /// when METIS finds a small separator, in two halves on both cores
+  /// 3800-grain benchmark, docs/performance.md); given a @p partition of its rows (from 4000
+  /// contacts, with a small separator), in two halves on both cores
   /// (dem/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
   /// each factorise() is one numeric factorisation. A wall clump touched by m
   /// contacts would make an m x m dense block: it stays out as U'U'^T, K_s = K - U'U'^T is
@@ -31,10 +31,9 @@ namespace tribo::dem
   class ShiftedFactorisation
   {
   public:
-    /// @p partition: the rows' halves for two threads (grain_bisection(); empty: METIS's
-    /// node separator of K's graph).
-    ShiftedFactorisation(const FrictionlessProblem::Scaled &p, unsigned int threads,
-                         const std::vector<int> &partition = {});
+    /// @p partition: the rows' halves for two threads (grain_bisection()); empty: K whole.
+    explicit ShiftedFactorisation(const FrictionlessProblem::Scaled &p,
+                                  const std::vector<int> &partition = {});
     /// Factorise K with this @p barrier (dimensionless, >= 0, one per contact); false if
     /// CHOLMOD fails (K numerically not positive definite).
     bool factorise(const Eigen::VectorXd &barrier);

@@ -63,10 +63,11 @@ namespace tribo::dem
       return worst;
     };
 
-    // With two threads, K in two halves split along an edge cut of the grains.
-    ShiftedFactorisation K(scaled, prm.threads,
-                           prm.threads > 1 && n >= BisectedCholesky::min_rows ? grain_bisection(contacts, state)
-                                                                               : std::vector<int>{});
+    // With two threads, K in two halves split along an edge cut of the grains (on one core
+    // the split costs more than it saves: K whole).
+    ShiftedFactorisation K(scaled, prm.threads > 1 && n >= BisectedCholesky::min_rows
+                                     ? grain_bisection(contacts, state)
+                                     : std::vector<int>{});
     Eigen::VectorXd r(n), rhs(n), dy(n), ds(n), dy_a(n), ds_a(n), dy_c(n), ds_c(n);
     Eigen::VectorXd barrier(n); // s / y + shift, K's diagonal beyond A'
     auto solve = [&](const Eigen::VectorXd &v) { return K.solve(v); };

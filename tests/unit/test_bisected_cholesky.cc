@@ -34,12 +34,26 @@ namespace
     A.setFromTriplets(t.begin(), t.end());
     return A;
   }
+
+  /// The strip's rows split by two cuts across it, at columns 0 and length / 2 (the
+  /// separator, 2 width rows), into the columns between them (0) and the others (1);
+  /// with @p every > 0, every such column is a cut as well.
+  std::vector<int> two_cuts(int length, int width, int every = 0)
+  {
+    std::vector<int> part(length * width);
+    for (int i = 0; i < length; ++i)
+      for (int j = 0; j < width; ++j)
+        part[i * width + j] = i == 0 || i == length / 2 || (every > 0 && i % every == 0) ? 2
+                              : i < length / 2                                         ? 0
+                                                                                        : 1;
+    return part;
+  }
 } // namespace
 
 TEST(BisectedCholesky, SolvesAPeriodicStripAsTheWholeFactorDoes)
 {
   const Eigen::SparseMatrix<double> A = periodic_strip(400, 12); // 4800 rows
-  BisectedCholesky                  halves(A, true);
+  BisectedCholesky                  halves(A, two_cuts(400, 12));
   ASSERT_TRUE(halves.split());
   // The interior point's shifts span many decades, up to the crossover's 1e20 on open rows.
   Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0).array().sin();
@@ -59,10 +73,10 @@ TEST(BisectedCholesky, SolvesAPeriodicStripAsTheWholeFactorDoes)
     }
 }
 
-TEST(BisectedCholesky, SmallOrOneThreadProblemsAreFactorisedWhole)
+TEST(BisectedCholesky, SmallProblemsAndLargeSeparatorsAreNotSplit)
 {
-  EXPECT_FALSE(BisectedCholesky(periodic_strip(300, 12), true).split()); // 3600 < min_rows
-  EXPECT_FALSE(BisectedCholesky(periodic_strip(400, 12), false).split());
-  // A square grid's separator (about 70 rows) is within the limits; a denser graph's is not.
-  EXPECT_TRUE(BisectedCholesky(periodic_strip(70, 70), true).split());
+  EXPECT_TRUE(BisectedCholesky(periodic_strip(400, 12), two_cuts(400, 12)).split());
+  EXPECT_FALSE(BisectedCholesky(periodic_strip(400, 12), {}).split());                   // no partition
+  EXPECT_FALSE(BisectedCholesky(periodic_strip(300, 12), two_cuts(300, 12)).split());    // 3600 < min_rows
+  EXPECT_FALSE(BisectedCholesky(periodic_strip(400, 12), two_cuts(400, 12, 10)).split()); // 10 % separator
 }
