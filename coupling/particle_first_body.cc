@@ -98,15 +98,22 @@ namespace tribo::coupling
         }
     engine_free = false;
     asymmetry   = (D - D.transpose()).norm() / D.norm();
-    // sym(D) is positive semi-definite for a linear conservative body (file comment);
-    // round-off and the nonlinear terms may leave tiny negative eigenvalues: clip them.
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (D + D.transpose()));
-    const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
-    G            = eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose() / (prm.theta * h);
+    G             = positive_part(D) / (prm.theta * h);
     compliance_h  = h;
     stale         = false;
     built_at_step = steps;
+    recent_miss   = 0;
     ++builds;
+  }
+
+  Eigen::MatrixXd ParticleFirstBody::positive_part(const Eigen::MatrixXd &D)
+  {
+    // sym(D) is positive semi-definite for a linear conservative body (file comment);
+    // round-off, the nonlinear terms and the secant updates may leave negative
+    // eigenvalues: clip them.
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (D + D.transpose()));
+    const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(0.0);
+    return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
   }
 
   void ParticleFirstBody::predict(double h)
@@ -184,10 +191,18 @@ namespace tribo::coupling
         ++steps_with_contacts;
         real_response_work += R.dot(d - free_displacement);
         predicted_response_work += R.dot(response);
+        // The relaxed Powell-symmetric-Broyden update of sym(D) = theta h G towards this
+        // step's secant, D R = d - d_free (file comment).
+        const Eigen::VectorXd e  = d - free_displacement - response;
+        const double          rr = R.squaredNorm();
+        const Eigen::MatrixXd update =
+          (e * R.transpose() + R * e.transpose()) / rr - (e.dot(R) / (rr * rr)) * (R * R.transpose());
+        G = positive_part(th * h * G + secant_relaxation * update) / (th * h);
+        recent_miss += (last_miss - recent_miss) / miss_memory;
+        if (recent_miss > compliance_tolerance)
+          stale = true;
       }
     ++steps;
-    if (last_miss > compliance_tolerance && steps >= built_at_step + compliance_min_interval)
-      stale = true;
 
     time += h;
     for (unsigned int i = 0; i < n; ++i)
@@ -240,7 +255,7 @@ namespace tribo::coupling
     save_engine(ar);
     ar << time << step_h << load_work << dissipated << extra_work << compliance_h << stale << builds << steps
        << built_at_step << steps_with_contacts << miss_sum << worst_miss << asymmetry << real_response_work
-       << predicted_response_work;
+       << predicted_response_work << recent_miss;
     const std::vector<double> g(G.data(), G.data() + G.size());
     ar << g;
     for (const std::vector<dem::Vec2> *v : {&end_velocity, &mean_velocity})
@@ -253,7 +268,7 @@ namespace tribo::coupling
     load_engine(ar);
     ar >> time >> step_h >> load_work >> dissipated >> extra_work >> compliance_h >> stale >> builds >> steps >>
       built_at_step >> steps_with_contacts >> miss_sum >> worst_miss >> asymmetry >> real_response_work >>
-      predicted_response_work;
+      predicted_response_work >> recent_miss;
     std::vector<double> g;
     ar >> g;
     if (g.size() != std::size_t(G.size()))
