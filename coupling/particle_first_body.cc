@@ -101,7 +101,6 @@ namespace tribo::coupling
     G             = positive_part(D) / (prm.theta * h);
     compliance_h  = h;
     stale         = false;
-    built_at_step = steps;
     recent_miss   = 0;
     ++builds;
   }
@@ -254,7 +253,7 @@ namespace tribo::coupling
   {
     save_engine(ar);
     ar << time << step_h << load_work << dissipated << extra_work << compliance_h << stale << builds << steps
-       << built_at_step << steps_with_contacts << miss_sum << worst_miss << asymmetry << real_response_work
+       << steps_with_contacts << miss_sum << worst_miss << asymmetry << real_response_work
        << predicted_response_work << recent_miss;
     const std::vector<double> g(G.data(), G.data() + G.size());
     ar << g;
@@ -267,7 +266,7 @@ namespace tribo::coupling
   {
     load_engine(ar);
     ar >> time >> step_h >> load_work >> dissipated >> extra_work >> compliance_h >> stale >> builds >> steps >>
-      built_at_step >> steps_with_contacts >> miss_sum >> worst_miss >> asymmetry >> real_response_work >>
+      steps_with_contacts >> miss_sum >> worst_miss >> asymmetry >> real_response_work >>
       predicted_response_work >> recent_miss;
     std::vector<double> g;
     ar >> g;

@@ -171,7 +171,7 @@ namespace tribo::coupling
     /// sum over steps of R . (d - d_free) and R . D R, J/m x h: their ratio says whether
     /// the real body yields more (> 1) or less than the compliance predicted.
     double                 real_response_work = 0, predicted_response_work = 0;
-    unsigned long          builds = 0, steps = 0, built_at_step = 0, steps_with_contacts = 0;
+    unsigned long          builds = 0, steps = 0, steps_with_contacts = 0;
     unsigned int           substeps = 0;
   };
 } // namespace tribo::coupling
