@@ -34,7 +34,7 @@ def main(source, target):
         time_ax.loglog(n, bound, ":", color=colour, lw=1)
         iter_ax.semilogx(n, it, "o-", color=colour, label=method)
     time_ax.set_xlabel("grains N")
-    time_ax.set_ylabel("ms per step (one core)")
+    time_ax.set_ylabel("ms per step (one core unless the label says two threads)")
     time_ax.set_title("time per step; dotted: c N log N from the smallest sample")
     time_ax.legend(fontsize=8)
     iter_ax.set_xlabel("grains N")
