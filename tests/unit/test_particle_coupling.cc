@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 using namespace tribo;
 using dem::Vec2;
@@ -164,13 +165,28 @@ namespace
     double miss = 0;                       ///< the real response against G's prediction
   };
 
-  Compliance compliance_of(const std::string &model, double courant)
+  /// The column's body at rest, its top just loaded by P (no ramp, no damping), for steps @p h.
+  std::unique_ptr<coupling::FirstBody> body_at_rest(const std::string &model, double h)
   {
-    const double h = step_for(courant);
-    auto         p = column_body(model, h, 0);
+    auto p = column_body(model, h, 0);
     p.pressure_ramp_time = 0;
     p.compaction_damping = 0;
-    auto  body = coupling::make_first_body(p);
+    return coupling::make_first_body(p);
+  }
+
+  /// A grain pushing chain particle 3 up and sideways with P s h, its neighbour less.
+  std::vector<Vec2> two_grain_impulses(unsigned int nodes, double h)
+  {
+    std::vector<Vec2> R(nodes, Vec2::Zero());
+    R[3] = Vec2(0.3, 1) * P * s * h;
+    R[4] = Vec2(-0.1, 0.5) * P * s * h;
+    return R;
+  }
+
+  Compliance compliance_of(const std::string &model, double courant)
+  {
+    const double h    = step_for(courant);
+    auto         body = body_at_rest(model, h);
     auto &particles = dynamic_cast<coupling::ParticleFirstBody &>(*body);
     body->predict(h);
     const Eigen::MatrixXd G = body->compliance();
@@ -182,11 +198,7 @@ namespace
     const Eigen::VectorXd lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G).eigenvalues();
     out.eigen_min = lambda.minCoeff() / lambda.maxCoeff();
     out.asymmetry = particles.compliance_asymmetry();
-    // A grain pushing chain particle 3 up and sideways with P s h, its neighbour less.
-    std::vector<Vec2> R(body->n_nodes(), Vec2::Zero());
-    R[3] = Vec2(0.3, 1) * P * s * h;
-    R[4] = Vec2(-0.1, 0.5) * P * s * h;
-    body->finalize(R);
+    body->finalize(two_grain_impulses(body->n_nodes(), h));
     out.miss = particles.linearisation_error();
     std::printf("%s at c_p h / s = %g: G_kk m in [%.4f, %.4f], eigenvalues down to %.3g of the largest, "
                 "asymmetry %.3g, linearisation miss %.3g\n",
@@ -217,15 +229,10 @@ namespace
   /// compliance_of()); the compliance is built once and then only secant-updated.
   std::vector<double> misses_under_a_repeated_load(const std::string &model, unsigned int steps)
   {
-    const double h = step_for(4);
-    auto         p = column_body(model, h, 0);
-    p.pressure_ramp_time = 0;
-    p.compaction_damping = 0;
-    auto  body = coupling::make_first_body(p);
+    const double h    = step_for(4);
+    auto         body = body_at_rest(model, h);
     auto &particles = dynamic_cast<coupling::ParticleFirstBody &>(*body);
-    std::vector<Vec2> R(body->n_nodes(), Vec2::Zero());
-    R[3] = Vec2(0.3, 1) * P * s * h;
-    R[4] = Vec2(-0.1, 0.5) * P * s * h;
+    const std::vector<Vec2> R = two_grain_impulses(body->n_nodes(), h);
     std::vector<double> misses;
     for (unsigned int k = 0; k < steps; ++k)
       {
