@@ -60,8 +60,20 @@ namespace tribo::dem
     /// into [0, period) if periodic) with gap <= @p distance. With @p threads > 1
     /// the rows of cells are searched in 4 @p threads chunks concurrently (TBB through
     /// deal.II); the contacts and their order do not depend on @p threads.
+    ///
+    /// With @p motion (one vector per disc, m: how far its centre may move before the next
+    /// detection), a pair further apart than @p distance is a contact too when that motion
+    /// closes it: gap <= -(motion_j - motion_i).n, n the unit normal from i to j. Fast
+    /// discs then meet their new neighbours as contacts with a positive gap, which the laws
+    /// close exactly, instead of passing into them undetected (docs/laws.md, "Detection"),
+    /// as long as the relative motion is at most max_motion_reach largest radii.
     std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &centres,
-                                double distance, unsigned int threads = 1);
+                                double distance, unsigned int threads = 1,
+                                const std::vector<Vec2> &motion = {});
+    /// The motions widen the cells by at most this many largest radii (at most twice the
+    /// cells without motion, four times the candidate pairs); pairs closed by a larger
+    /// relative motion are not looked for.
+    static constexpr double max_motion_reach = 2;
 
   private:
     std::vector<unsigned int> cell_start, cell_items, cell_of;

@@ -126,6 +126,11 @@ namespace tribo::dem
     const ContactLaw &law() const { return contact_law; }
     double theta() const { return th; }
     double detection_distance() const { return distance; }
+    /// Steps of motion at the start velocity over which a pair beyond the detection
+    /// distance is still a contact when it closes (dem/contact.h ContactDetector::detect):
+    /// the discs move h v_end before the next detection, and the margin covers an end
+    /// velocity up to twice the start one.
+    static constexpr double lookahead = 2;
 
     /// Checkpoint: the impulses of the last step (the next step's warm start) and the
     /// solver's random state. The attached boundary body saves its own state.
@@ -192,6 +197,7 @@ namespace tribo::dem
     // Scratch of one step, between its phases.
     std::vector<Eigen::Vector3d> v_begin, v_free, v_mid_of; ///< (vx, vy, spin) per body
     std::vector<Vec2>            x_pred;                    ///< predicted positions, m
+    std::vector<Vec2>            disc_motion;               ///< lookahead h v per disc, m (detect())
     std::vector<double>          angle_pred;                ///< predicted angles, rad
     std::vector<Vec2>            node_v_begin;              ///< boundary nodes' velocities at the start
   };

@@ -1,5 +1,6 @@
 // Cell-list detection against brute force, with and without x-periodicity, and the
 // threaded search against the serial one.
+#include "core/errors.h"
 #include "dem/contact.h"
 
 #include <gtest/gtest.h>
@@ -11,8 +12,9 @@ using namespace tribo::dem;
 
 namespace
 {
+  /// Every pair within @p distance, or closed by its discs' @p motion (when given).
   std::set<std::pair<unsigned, unsigned>> brute_force(const ParticleSystem &s, const std::vector<Vec2> &x,
-                                                      double distance)
+                                                      double distance, const std::vector<Vec2> &motion = {})
   {
     std::set<std::pair<unsigned, unsigned>> pairs;
     for (unsigned i = 0; i < x.size(); ++i)
@@ -23,7 +25,9 @@ namespace
           Vec2 d = x[j] - x[i];
           if (s.period > 0)
             d.x() -= s.period * std::round(d.x() / s.period);
-          if (d.norm() - s.discs[i].radius - s.discs[j].radius <= distance)
+          const double gap     = d.norm() - s.discs[i].radius - s.discs[j].radius;
+          const double closing = motion.empty() ? 0 : -(motion[j] - motion[i]).dot(d) / d.norm();
+          if (gap <= distance || gap <= closing)
             pairs.insert({i, j});
         }
     return pairs;
@@ -40,14 +44,22 @@ namespace
     return s;
   }
 
-  void compare(double period)
+  /// Cell list against brute force; with @p speed > 0, random disc motions of up to @p speed
+  /// times the mean radius.
+  void compare(double period, double speed = 0)
   {
     const ParticleSystem s = random_discs(period);
-    std::vector<Vec2>    x;
+    std::vector<Vec2>    x, motion;
+    std::mt19937                           rng(11);
+    std::uniform_real_distribution<double> um(-speed * 0.5e-6, speed * 0.5e-6);
     for (unsigned d = 0; d < s.discs.size(); ++d)
-      x.push_back(s.wrap(s.disc_centre(d)));
+      {
+        x.push_back(s.wrap(s.disc_centre(d)));
+        if (speed > 0)
+          motion.emplace_back(um(rng), um(rng));
+      }
     ContactDetector detector;
-    const auto      contacts = detector.detect(s, x, 1e-7);
+    const auto      contacts = detector.detect(s, x, 1e-7, 1, motion);
     std::set<std::pair<unsigned, unsigned>> found;
     for (const auto &c : contacts)
       {
@@ -55,15 +67,44 @@ namespace
         EXPECT_NEAR(c.normal.norm(), 1.0, 1e-14);
         EXPECT_NEAR(c.branch.norm() - s.discs[c.disc[0]].radius - s.discs[c.disc[1]].radius, c.gap, 1e-20);
       }
-    const auto expected = brute_force(s, x, 1e-7);
+    const auto expected = brute_force(s, x, 1e-7, motion);
     EXPECT_EQ(found, expected);
     EXPECT_GT(expected.size(), 100u);
+    if (speed > 0) // the motions add pairs beyond the distance
+      EXPECT_GT(expected.size(), brute_force(s, x, 1e-7).size() + 20);
   }
 } // namespace
 
 TEST(Detection, CellListFindsTheBruteForcePairs) { compare(0); }
 
 TEST(Detection, CellListFindsPairsAcrossThePeriodicBoundary) { compare(20e-6); }
+
+// Pairs beyond the detection distance that the discs' motions close (relative motions up to
+// 1.9 largest radii, within ContactDetector::max_motion_reach) are found as brute force
+// finds them.
+TEST(Detection, CellListFindsThePairsTheMotionsClose)
+{
+  compare(0, 0.8);
+  compare(20e-6, 0.8);
+}
+
+TEST(Detection, AMotionPerDiscIsRequired)
+{
+  const ParticleSystem s = random_discs(0);
+  std::vector<Vec2>    x;
+  for (unsigned d = 0; d < s.discs.size(); ++d)
+    x.push_back(s.disc_centre(d));
+  ContactDetector detector;
+  try
+    {
+      detector.detect(s, x, 1e-7, 1, std::vector<Vec2>(3, Vec2::Zero()));
+      FAIL() << "no error";
+    }
+  catch (const tribo::RunError &e)
+    {
+      EXPECT_STREQ(e.what(), "contact detection: 3 disc motions for 300 discs");
+    }
+}
 
 // Rows of cells searched in 4 T chunks concurrently and joined in order: the same
 // contacts in the same order, bit for bit, as the serial pass.

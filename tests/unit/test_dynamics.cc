@@ -89,6 +89,31 @@ TEST(Dynamics, IqsHeadOnCollisionConservesMomentumAndStopsTheApproach)
   EXPECT_LT(gap, 1e-15);
 }
 
+// Two discs closing at 10 m/s with a detection distance of 1e-9 m and h = 1e-8 s: at the
+// first step's predicted configuration their gap g = 3e-8 m is far beyond the distance, but
+// less than the implicit half step's theta h v = 5e-8 m. Detected by their motion, IQS
+// closes the gap exactly at the end of that step, leaving them approaching at g / (theta h)
+// = 6 m/s; the next explicit half step carries them (1 - theta) h 6 m/s = 3e-8 m into each
+// other, and IQS keeps that overlap. Found by the distance alone, they would pass into each
+// other undetected and the next step would find them h v - g = 7e-8 m deep.
+TEST(Dynamics, AFastPairIsDetectedBeforeItCloses)
+{
+  const double   v = 10, h = 1e-8, g = 3e-8;
+  ParticleSystem s = pair(v, g + 0.5 * h * v);
+  MoreauJean     mj(0.5, ContactLaw{}, tight(), 1e-9);
+  auto           gap = [&] { return (s.bodies[1].position - s.bodies[0].position).norm() - 2 * r; };
+  mj.step(s, h);
+  ASSERT_EQ(mj.contacts().size(), 1u);
+  EXPECT_NEAR(mj.contacts()[0].gap, g, 1e-20);
+  EXPECT_GT(mj.contacts()[0].r.x(), 0.0);
+  EXPECT_NEAR(gap(), 0.0, 1e-20);
+  EXPECT_NEAR(s.bodies[0].velocity.x() - s.bodies[1].velocity.x(), g / (0.5 * h), 1e-9);
+  for (int i = 0; i < 3; ++i)
+    mj.step(s, h);
+  EXPECT_NEAR(gap(), -0.5 * h * g / (0.5 * h), 1e-20);
+  EXPECT_NEAR(s.bodies[1].velocity.x() - s.bodies[0].velocity.x(), 0.0, 1e-9);
+}
+
 TEST(Dynamics, ElasContactLastsPiSqrtMOverK)
 {
   ContactLaw law;
