@@ -25,7 +25,8 @@ namespace tribo::dem
     // The largest relative motion of two discs: twice the largest distance of a motion from
     // the middle of their bounding box, at most max_motion_reach largest radii (a few fast
     // discs cannot widen the cells without bound; pairs further apart are missed as
-    // without motions, and the overlap guard of the step names the fastest mover).
+    // without motions, and the overlap guard of the step names the fastest mover), and never
+    // so much that a period which holds two reaches without motions would not hold two now.
     double closing_reach = 0;
     if (!motion.empty())
       {
@@ -39,6 +40,8 @@ namespace tribo::dem
         for (const Vec2 &m : motion)
           closing_reach = std::max(closing_reach, 2 * (m - middle).norm());
         closing_reach = std::min(closing_reach, max_motion_reach * system.max_radius());
+        if (system.period > 0)
+          closing_reach = std::min(closing_reach, 0.5 * system.period - 2 * system.max_radius());
       }
     // Cell size: the largest centre distance that can still be a contact.
     const double reach = 2 * system.max_radius() + std::max({distance, closing_reach, 0.0});

@@ -88,6 +88,27 @@ TEST(Detection, CellListFindsThePairsTheMotionsClose)
   compare(20e-6, 0.8);
 }
 
+// A narrow period that holds two reaches without motions (2.6 um in 2.8 um) still does with
+// a disc moving 1 mm: the motions widen the cells only as far as the period allows, and the
+// pairs within the distance are found.
+TEST(Detection, FastDiscsInANarrowPeriodAreNoError)
+{
+  ParticleSystem s;
+  s.period = 2.8e-6;
+  for (int k = 0; k < 3; ++k)
+    s.add_disc({1e-6, 1.25e-6 * k}, 0.6e-6, 7800); // gaps of 5e-8 m
+  std::vector<Vec2> x, motion(3, Vec2::Zero());
+  for (unsigned d = 0; d < s.discs.size(); ++d)
+    x.push_back(s.disc_centre(d));
+  motion[0] = {1e-3, 0};
+  ContactDetector detector;
+  const auto      contacts = detector.detect(s, x, 1e-7, 1, motion);
+  std::set<std::pair<unsigned, unsigned>> found;
+  for (const auto &c : contacts)
+    found.insert({c.disc[0], c.disc[1]});
+  EXPECT_EQ(found, (std::set<std::pair<unsigned, unsigned>>{{0, 1}, {1, 2}}));
+}
+
 TEST(Detection, AMotionPerDiscIsRequired)
 {
   const ParticleSystem s = random_discs(0);
