@@ -23,9 +23,9 @@ import numpy as np
 BATCHES = 10
 
 
-def batch_means(values):
-    """The B batch means of @p values (time order)."""
-    return np.array([b.mean() for b in np.array_split(np.asarray(values), BATCHES)])
+def batch_means(values, batches=BATCHES):
+    """The @p batches batch means of @p values (time order)."""
+    return np.array([b.mean() for b in np.array_split(np.asarray(values), batches)])
 
 
 def mean_stderr(batches):

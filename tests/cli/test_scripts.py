@@ -71,5 +71,61 @@ class CompareProfiles(TempDirTestCase):
         self.assertIn(os.path.join(b, "profiles.csv") + ": expected the columns solid_fraction", r.stderr)
 
 
+def write_statistics(directory, mu, load=4000.0, dt=1e-7):
+    """A statistics.csv with one row per value of @p mu, every dt seconds from 0: the lower
+    wall carries 1.01 load on even rows and 0.99 on odd ones."""
+    os.makedirs(directory)
+    with open(os.path.join(directory, "statistics.csv"), "w") as f:
+        f.write("time,step,mu,normal_force,lower_wall_normal_force,max_overlap\n")
+        for i, m in enumerate(mu):
+            f.write(f"{i * dt!r},{i},{float(m)!r},{load!r},{load * (1.01 if i % 2 == 0 else 0.99)!r},{1e-9 * i!r}\n")
+
+
+def compare_friction(*args):
+    return subprocess.run([sys.executable, os.path.join(SCRIPTS, "compare_friction.py")] + list(args),
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, timeout=120)
+
+
+class CompareFriction(TempDirTestCase):
+    def test_means_errors_and_differences(self):
+        # 40 rows in the window. Run a: its 10 batches of 4 rows alternate 0.09 and 0.11,
+        # so mu = 0.1 with the standard error of those ten means; run b is a + 0.02, so the
+        # difference is 0.02 with a combined error sqrt(2) times a's.
+        a_mu = np.repeat([0.09, 0.11] * 5, 4)
+        a, b = os.path.join(self.tmp, "a"), os.path.join(self.tmp, "b")
+        write_statistics(a, np.concatenate([[5.0] * 10, a_mu]))  # 10 rows before the window
+        write_statistics(b, np.concatenate([[5.0] * 10, a_mu + 0.02]))
+        r = compare_friction("1", "4.95", a, b)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = [line.split("|")[1:-1] for line in r.stdout.splitlines() if line.startswith("| ")]
+        se10 = np.std([0.09, 0.11] * 5, ddof=1) / np.sqrt(10)
+        self.assertEqual(rows[1][1].strip(), "40, 1.00-4.90")
+        self.assertEqual(rows[1][2].strip(), "0.1000 +/- %.4f" % se10)
+        self.assertEqual(rows[2][2].strip(), "0.1200 +/- %.4f" % se10)
+        self.assertEqual(rows[1][4].strip(), "1.0000 +/- 0.0000")  # 1.01 and 0.99 alternate within batches
+        self.assertEqual(rows[1][5].strip(), "4.900e-08")
+        diff = rows[-1]
+        self.assertEqual(diff[1].strip(), "+0.0200")
+        self.assertTrue(diff[3].strip().startswith("%+.1f / " % (0.02 / (np.sqrt(2) * se10))))
+
+    def test_a_window_outside_a_run_is_named(self):
+        a = os.path.join(self.tmp, "a")
+        write_statistics(a, [0.1] * 20)
+        r = compare_friction("5", "9", a)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(os.path.join(a, "statistics.csv") + ": 0 rows in 5-9 us (the run holds 0-1.9 us); "
+                      "at least 4 are needed", r.stderr)
+
+    def test_a_missing_column_is_named(self):
+        a = os.path.join(self.tmp, "a")
+        os.makedirs(a)
+        with open(os.path.join(a, "statistics.csv"), "w") as f:
+            f.write("time,mu\n0,0.1\n1e-7,0.1\n")
+        r = compare_friction("0", "1", a)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(os.path.join(a, "statistics.csv") + ": expected the columns normal_force, "
+                      "lower_wall_normal_force, max_overlap", r.stderr)
+
+
 if __name__ == "__main__":
     main()
