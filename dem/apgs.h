@@ -27,8 +27,11 @@
 /// above the target and their neighbours up to polish_rings rings away in A' (while they are
 /// at most polish_fraction of all) get polish_passes projected Gauss-Seidel passes, in the
 /// sweep's order, over them alone (y changed in place, z by the same amount, so the momentum
-/// y - y_last is kept), then a new check; at most polishes_per_check times between two
-/// blocks of sweeps. The warm start's worst contacts are a tail whose error grows with the
+/// y - y_last is kept), then a new check of the rows the polish changed (the polished
+/// contacts' rows of A', and the walls' low-rank rows when a polished contact is one of
+/// them; the other contacts' map is still the last check's: the same bits as a whole check
+/// at a fraction of its cost, not counted as a pass since 2026-11-27, eighth session); at
+/// most polishes_per_check times between two blocks of sweeps. The warm start's worst contacts are a tail whose error grows with the
 /// sample (its largest |min(y_j, g_j)| over the mean impulse 6e-3, 1.2e-2, 2.1e-2 and 4.8e-2
 /// at 1000, 4000, 16 000 and 64 000 grains, while its root mean square stays near 6e-4):
 /// whole sweeps spent on that tail are what made the sweeps grow with the width, and the
@@ -61,7 +64,8 @@ namespace tribo::dem
     static constexpr unsigned int polishes_per_check = 4;
     /// ... and only while those contacts are at most this fraction of all.
     static constexpr double polish_fraction = 0.05;
-    /// The report's iterations are the sweeps plus the products of the checks.
+    /// The report's iterations are the sweeps plus the whole checks (one product each); the
+    /// polishes and their checks of the polished rows are not counted.
     SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
 
   private:

@@ -87,12 +87,34 @@ namespace tribo::dem
   std::vector<Contact> HalfDiscs::detect(const ParticleSystem &system,
                                          const std::vector<Vec2> &disc_centres,
                                          const std::vector<double> &body_angles,
-                                         const std::vector<Vec2> &nodes, double distance) const
+                                         const std::vector<Vec2> &nodes, double distance,
+                                         const std::vector<Vec2> &disc_motion,
+                                         const std::vector<Vec2> &node_motion) const
   {
     std::vector<Contact> found;
     const unsigned int   nh  = count();
     const double         rho = radius();
-    const double         reach = rho + system.max_radius() + std::max(distance, 0.0);
+    if ((!disc_motion.empty() && disc_motion.size() != system.discs.size()) ||
+        (!node_motion.empty() && node_motion.size() != nodes.size()))
+      throw RunError("half-disc detection: " + std::to_string(disc_motion.size()) + " disc motions for " +
+                     std::to_string(system.discs.size()) + " discs and " + std::to_string(node_motion.size()) +
+                     " node motions for " + std::to_string(nodes.size()) + " nodes");
+    // The centres' motions (interpolated from the nodes' as the centres are) and the largest
+    // relative motion of a disc and a half-disc, capped as ContactDetector::detect caps it.
+    std::vector<Vec2> centre_motion(nh, Vec2::Zero());
+    double            largest_disc = 0, largest_centre = 0;
+    for (const Vec2 &m : disc_motion)
+      largest_disc = std::max(largest_disc, m.norm());
+    if (!node_motion.empty())
+      for (unsigned int k = 0; k < nh; ++k)
+        {
+          const unsigned int e = anchor_edge[k];
+          centre_motion[k] = (1 - anchor_xi[k]) * node_motion[e] + anchor_xi[k] * node_motion[(e + 1) % nodes.size()];
+          largest_centre   = std::max(largest_centre, centre_motion[k].norm());
+        }
+    const double closing_reach =
+      std::min(largest_disc + largest_centre, ContactDetector::max_motion_reach * system.max_radius());
+    const double reach = rho + system.max_radius() + std::max({distance, closing_reach, 0.0});
     std::vector<Placement> at(nh);
     double                 ymin = INFINITY, ymax = -INFINITY;
     for (unsigned int k = 0; k < nh; ++k)
@@ -150,7 +172,12 @@ namespace tribo::dem
               const double dist = branch.norm();
               const double gap  = dist - R - rho;
               if (gap > distance)
-                continue;
+                {
+                  const Vec2 relative =
+                    (disc_motion.empty() ? Vec2(Vec2::Zero()) : disc_motion[d]) - centre_motion[k];
+                  if (gap > -relative.dot(branch) / dist)
+                    continue; // beyond the distance, and the motions do not close it
+                }
               Contact ct;
               ct.disc[0]   = d; // for the warm-start key only (with half_disc)
               ct.disc[1]   = d;

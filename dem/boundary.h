@@ -110,9 +110,17 @@ namespace tribo::dem
     /// [0, period)) with the half-discs at node positions @p nodes, for gaps up to
     /// @p distance. Fills geometry, node indices and node maps; side 0 is the
     /// half-disc, side 1 the grain's body (its arms are set).
+    /// With @p disc_motion (one per disc) and @p node_motion (one per node), how far each
+    /// may move before the next detection (m), a pair further apart is a contact too when
+    /// their motions close it, gap <= -(m_disc - m_centre).n with n from the half-disc to
+    /// the grain and m_centre the nodes' motions interpolated as the centre is, as
+    /// ContactDetector::detect does for two discs and with its cap: relative motions of at
+    /// most ContactDetector::max_motion_reach largest radii are looked for.
     std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &disc_centres,
                                 const std::vector<double> &disc_angles_of_bodies,
-                                const std::vector<Vec2> &nodes, double distance) const;
+                                const std::vector<Vec2> &nodes, double distance,
+                                const std::vector<Vec2> &disc_motion = {},
+                                const std::vector<Vec2> &node_motion = {}) const;
 
   private:
     /// Where half-disc @p k is for node positions @p nodes: its centre (m, near its

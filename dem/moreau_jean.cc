@@ -177,18 +177,19 @@ namespace tribo::dem
         phase                 = std::chrono::steady_clock::now();
         boundary->predict(h);
         report.time_boundary_body = seconds_since(phase);
-        std::vector<Vec2> nodes(nn);
+        std::vector<Vec2> nodes(nn), node_motion(nn);
         node_v_begin.resize(nn);
         state.node_velocity.resize(2 * nn);
         for (unsigned int i = 0; i < nn; ++i)
           {
             node_v_begin[i] = boundary->node_velocity(i);
             nodes[i]        = boundary->node_position(i) + (1 - th) * h * node_v_begin[i];
+            node_motion[i]  = lookahead * h * node_v_begin[i]; // as the discs' motions
             state.node_velocity.segment<2>(2 * i) = boundary->node_free_velocity(i);
           }
         state.node_compliance = &boundary->compliance();
         phase            = std::chrono::steady_clock::now();
-        auto on_boundary = half_discs->detect(system, centres, angle_pred, nodes, distance);
+        auto on_boundary = half_discs->detect(system, centres, angle_pred, nodes, distance, disc_motion, node_motion);
         report.time_detection += seconds_since(phase);
         report.n_boundary_contacts = on_boundary.size();
         found.insert(found.end(), on_boundary.begin(), on_boundary.end());

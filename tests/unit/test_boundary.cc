@@ -159,6 +159,49 @@ TEST(HalfDiscs, DetectedAcrossThePeriodicBoundary)
       }
 }
 
+TEST(HalfDiscs, ThePairsTheMotionsCloseAreDetected)
+{
+  // Half-disc 2 (centre x = 2.5 l, edge 2: nodes 2 and 3) and a grain straight below it at
+  // gap 0.3 l, beyond the distance 0.01 l. Motions until the next detection (m) of 0.2 l
+  // each: the nodes down and the grain up close the pair (0.4 l > 0.3 l); either alone
+  // does not; the nodes up (away) do not; the node motions of another edge do not.
+  LumpedChain    chain(8, L, y_face, 1e-8);
+  const double   r = 0.6e-6, distance = 0.01 * l;
+  ParticleSystem s;
+  s.period = L;
+  s.add_disc({2.5 * l, y_face - 0.5 * l - r - 0.3 * l}, r, rho);
+  const HalfDiscs hd(chain, l, {0, -1}, L);
+  const std::vector<Vec2> centres{s.wrap(s.discs[0].offset + s.bodies[0].position)};
+  auto count_with = [&](const Vec2 &grain, const Vec2 &nodes_2_3, const Vec2 &others) {
+    std::vector<Vec2> node_motion(8, others);
+    node_motion[2] = node_motion[3] = nodes_2_3;
+    unsigned int found = 0;
+    for (const Contact &c : hd.detect(s, centres, {0.0}, chain.x, distance, {grain}, node_motion))
+      if (c.half_disc == 2)
+        {
+          ++found;
+          EXPECT_NEAR(c.gap, 0.3 * l, 1e-15); // the gap now, not the predicted one
+        }
+    return found;
+  };
+  const Vec2 up(0, 0.2 * l), zero(0, 0);
+  EXPECT_EQ(count_with(up, -up, zero), 1u);
+  EXPECT_EQ(count_with(up, zero, zero), 0u);
+  EXPECT_EQ(count_with(zero, -up, zero), 0u);
+  EXPECT_EQ(count_with(up, up, zero), 0u);
+  EXPECT_EQ(count_with(up, zero, -up), 0u);
+  EXPECT_EQ(hd.detect(s, centres, {0.0}, chain.x, distance).size(), 0u); // no motions: as before
+  try
+    {
+      hd.detect(s, centres, {0.0}, chain.x, distance, {up, up}, {});
+      FAIL() << "two disc motions for one disc were accepted";
+    }
+  catch (const std::exception &e)
+    {
+      EXPECT_STREQ(e.what(), "half-disc detection: 2 disc motions for 1 discs and 0 node motions for 8 nodes");
+    }
+}
+
 TEST(HalfDiscs, GapRateIsTheGeometricRateOnATurnedAndStretchedFace)
 {
   // Nodes displaced and moving with a rotation, a stretch and a random part; grains
