@@ -24,8 +24,9 @@ namespace tribo::dem
     // |min(y_j, g_j)| / sqrt(D_j) is kept in `error` and the mean in `mean_loaded` (N s/m).
     Eigen::VectorXd error(n);
     double          mean_loaded = lcp.scale;
-    // Over fixed chunks (dem/scaled_operator.h), concurrently with Threads > 1, the same
-    // bits on any number of threads.
+    // Over fixed chunks (dem/scaled_operator.h), concurrently with Threads > 1, merged in
+    // chunk order: the same bits on any number of threads. The chunks' sums are kept, so
+    // that the check after a polish recomputes only the chunks that hold a changed row.
     struct MapSums
     {
       double worst = 0, loaded_sum = 0, loaded = 0;
@@ -36,30 +37,38 @@ namespace tribo::dem
         loaded += p.loaded;
       }
     };
-    // With @p affected, only the marked rows' map is recomputed (the others' entries of
-    // `error` are still those of y): the check after a polish, which changed y on a few
-    // contacts only. It gives the bits of a whole check and is not counted as a pass.
-    auto relative_map = [&](const Eigen::VectorXd &y, const std::vector<char> *affected = nullptr) {
-      if (!affected)
-        ++report.iterations;
-      op.set_vector(y);
-      const MapSums sums = over_chunks<MapSums>(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
-        MapSums part;
-        for (Eigen::Index j = first; j < last; ++j)
-          {
-            if (!affected || (*affected)[j])
-              error[j] = std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
-            part.worst = std::max(part.worst, error[j]);
-            if (y[j] > 0)
-              {
-                part.loaded_sum += y[j] * inv_root[j];
-                ++part.loaded;
-              }
-          }
-        return part;
-      });
-      mean_loaded = sums.loaded > 0 ? sums.loaded_sum / sums.loaded : lcp.scale;
+    std::vector<MapSums> chunk_sums;
+    // The map of the rows [first, last) (with @p affected, only the marked rows' entries of
+    // `error` are recomputed; the others are still those of y), op set to y.
+    auto map_of_rows = [&](const Eigen::VectorXd &y, Eigen::Index first, Eigen::Index last,
+                           const std::vector<char> *affected) {
+      MapSums part;
+      for (Eigen::Index j = first; j < last; ++j)
+        {
+          if (!affected || (*affected)[j])
+            error[j] = std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
+          part.worst = std::max(part.worst, error[j]);
+          if (y[j] > 0)
+            {
+              part.loaded_sum += y[j] * inv_root[j];
+              ++part.loaded;
+            }
+        }
+      return part;
+    };
+    auto merged_map = [&]() {
+      const MapSums sums = merged_in_order(chunk_sums);
+      mean_loaded        = sums.loaded > 0 ? sums.loaded_sum / sums.loaded : lcp.scale;
       return sums.worst / mean_loaded;
+    };
+    // A whole check: one pass.
+    auto relative_map = [&](const Eigen::VectorXd &y) {
+      ++report.iterations;
+      op.set_vector(y);
+      chunk_partials(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+        return map_of_rows(y, first, last, nullptr);
+      }, chunk_sums);
+      return merged_map();
     };
     // The sweep's order: the contacts (in detection order, rows of cells upwards) cut into
     // slab_count slabs of consecutive contacts, the even slabs first, then the odd ones.
@@ -126,23 +135,32 @@ namespace tribo::dem
     // their neighbours up to polish_rings rings away in A' (ring 1: the rows of their
     // columns), y changed in place and z by the same amount (the momentum y - y_last kept).
     // False when nothing is above the target or the neighbourhood is too large to be local.
-    // `affected` marks the rows whose map a polish changed: the rows of the polished
-    // columns in A', and the walls' low-rank rows (`low_rank_rows`) when a polished contact
-    // is one of them.
+    // It marks in `affected` (listed in `affected_rows`) the rows whose map it changed: the
+    // rows of the polished columns of A', and the walls' low-rank rows when a polished
+    // contact is one of them. All of it costs O(the polished contacts + the chunks).
     std::vector<char>         marked(n, 0), affected(n, 0);
-    std::vector<Eigen::Index> local, low_rank_rows;
+    std::vector<Eigen::Index> local, affected_rows, low_rank_rows;
     for (Eigen::Index j = 0; j < n; ++j)
       if (scaled.U.cols() > 0 && scaled.U.row(j).squaredNorm() > 0)
         low_rank_rows.push_back(j);
+    auto affect = [&](Eigen::Index j) {
+      if (!affected[j])
+        {
+          affected[j] = 1;
+          affected_rows.push_back(j);
+        }
+    };
     auto polish = [&](Eigen::VectorXd &y, Eigen::VectorXd &z) {
       const double threshold = prm.residual_target * mean_loaded;
       local.clear();
-      for (Eigen::Index j = 0; j < n; ++j)
-        {
-          marked[j] = error[j] > threshold;
-          if (marked[j])
-            local.push_back(j);
-        }
+      for (Eigen::Index c = 0; c < Eigen::Index(chunk_sums.size()); ++c)
+        if (chunk_sums[c].worst > threshold)
+          for (Eigen::Index j = c * chunk_size; j < std::min(n, (c + 1) * chunk_size); ++j)
+            if (error[j] > threshold)
+              {
+                marked[j] = 1;
+                local.push_back(j);
+              }
       std::size_t last_ring = 0; // local[last_ring, ...) is the outermost ring so far
       for (unsigned int ring = 0; ring < polish_rings && double(local.size()) <= polish_fraction * double(n); ++ring)
         {
@@ -155,6 +173,8 @@ namespace tribo::dem
                   local.push_back(a.row());
                 }
         }
+      for (const Eigen::Index j : local)
+        marked[j] = 0;
       std::sort(local.begin(), local.end()); // the sweep's order
       if (local.empty() || double(local.size()) > polish_fraction * double(n))
         return false;
@@ -170,19 +190,41 @@ namespace tribo::dem
                 y[j] = next;
               }
           }
-      std::fill(affected.begin(), affected.end(), 0);
       bool wall = false;
       for (const Eigen::Index j : local)
         {
           for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a; ++a)
-            affected[a.row()] = 1;
-          affected[j] = 1;
+            affect(a.row());
+          affect(j);
           wall = wall || (scaled.U.cols() > 0 && scaled.U.row(j).squaredNorm() > 0);
         }
       if (wall)
         for (const Eigen::Index j : low_rank_rows)
-          affected[j] = 1;
+          affect(j);
       return true;
+    };
+    // The check after a polish: the chunks that hold an affected row are recomputed, the
+    // others keep their sums (y did not change there): the bits of a whole check, at the
+    // polish's cost. Not counted as a pass.
+    std::vector<char> dirty(chunk_count(n), 0);
+    auto recheck = [&](const Eigen::VectorXd &y) {
+      op.set_vector(y);
+      std::vector<Eigen::Index> chunks;
+      for (const Eigen::Index j : affected_rows)
+        if (!dirty[j / chunk_size])
+          {
+            dirty[j / chunk_size] = 1;
+            chunks.push_back(j / chunk_size);
+          }
+      for (const Eigen::Index c : chunks)
+        {
+          chunk_sums[c] = map_of_rows(y, c * chunk_size, std::min(n, (c + 1) * chunk_size), &affected);
+          dirty[c]      = 0;
+        }
+      for (const Eigen::Index j : affected_rows)
+        affected[j] = 0;
+      affected_rows.clear();
+      return merged_map();
     };
 
     Eigen::VectorXd y = scaled.y.cwiseMax(0.0), y_last(n), z = y, next(n);
@@ -199,7 +241,7 @@ namespace tribo::dem
         if (polished < polishes_per_check && polish(y, z))
           {
             ++polished;
-            map = relative_map(y, &affected);
+            map = recheck(y);
             continue;
           }
         polished = 0;

@@ -17,14 +17,17 @@ namespace tribo::dem
   /// Entries per chunk of the fused passes.
   constexpr Eigen::Index chunk_size = 256;
 
-  /// Run @p body(begin, end) -> Partial over fixed chunks of [0, n), concurrently when
-  /// @p threads > 1, and merge the partials (Partial::merge) in chunk order.
+  /// Number of fixed chunks of [0, n).
+  inline Eigen::Index chunk_count(Eigen::Index n) { return (n + chunk_size - 1) / chunk_size; }
+
+  /// @p partial[c] = @p body(begin, end) -> Partial over each fixed chunk c of [0, n),
+  /// concurrently when @p threads > 1 (@p partial resized to chunk_count(n)).
   template <typename Partial, typename Body>
-  Partial over_chunks(Eigen::Index n, unsigned int threads, const Body &body)
+  void chunk_partials(Eigen::Index n, unsigned int threads, const Body &body, std::vector<Partial> &partial)
   {
-    const Eigen::Index   count = (n + chunk_size - 1) / chunk_size;
-    std::vector<Partial> partial(count);
-    auto                 work = [&](Eigen::Index first, Eigen::Index last) {
+    const Eigen::Index count = chunk_count(n);
+    partial.resize(count);
+    auto work = [&](Eigen::Index first, Eigen::Index last) {
       for (Eigen::Index c = first; c < last; ++c)
         partial[c] = body(c * chunk_size, std::min(n, (c + 1) * chunk_size));
     };
@@ -32,10 +35,26 @@ namespace tribo::dem
       dealii::parallel::apply_to_subranges(Eigen::Index(0), count, work, 1);
     else
       work(0, count);
+  }
+
+  /// The partials merged (Partial::merge) in chunk order: the same bits on any number of threads.
+  template <typename Partial>
+  Partial merged_in_order(const std::vector<Partial> &partial)
+  {
     Partial total;
     for (const Partial &p : partial)
       total.merge(p);
     return total;
+  }
+
+  /// Run @p body(begin, end) -> Partial over fixed chunks of [0, n), concurrently when
+  /// @p threads > 1, and merge the partials (Partial::merge) in chunk order.
+  template <typename Partial, typename Body>
+  Partial over_chunks(Eigen::Index n, unsigned int threads, const Body &body)
+  {
+    std::vector<Partial> partial;
+    chunk_partials(n, threads, body, partial);
+    return merged_in_order(partial);
   }
 
   /// A pass with nothing to reduce.
