@@ -229,7 +229,9 @@ namespace tribo::dem
 
     Eigen::VectorXd y = scaled.y.cwiseMax(0.0), y_last(n), z = y, next(n);
     double          t        = 1;
-    unsigned int    polished = 0; // polishes since the last sweep
+    // Polishes since the last block of sweeps, and since the lowest map among them.
+    unsigned int polished = 0, since_lowest = 0;
+    double       lowest   = INFINITY;
     double          map      = relative_map(y);
     while (map > prm.residual_target)
       {
@@ -238,13 +240,16 @@ namespace tribo::dem
             report.converged = false;
             break;
           }
-        if (polished < polishes_per_check && polish(y, z))
+        if (polished < max_polishes && since_lowest < polish_patience && polish(y, z))
           {
             ++polished;
             map = recheck(y);
+            since_lowest = map < lowest ? 0 : since_lowest + 1;
+            lowest       = std::min(lowest, map);
             continue;
           }
-        polished = 0;
+        polished = since_lowest = 0;
+        lowest                  = INFINITY;
         // The vector passes over fixed chunks, as the check (the same bits on any number of
         // threads); the next sweep's start (next = z) written with z.
         struct Sum

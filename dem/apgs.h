@@ -30,8 +30,10 @@
 /// y - y_last is kept), then a new check of the rows the polish changed (the polished
 /// contacts' rows of A', and the walls' low-rank rows when a polished contact is one of
 /// them; the other contacts' map is still the last check's: the same bits as a whole check
-/// at a fraction of its cost, not counted as a pass since 2026-11-27, eighth session); at
-/// most polishes_per_check times between two blocks of sweeps. The warm start's worst contacts are a tail whose error grows with the
+/// at the polish's cost, not counted as a pass since 2026-11-27, eighth session). Polishes
+/// go on until polish_patience of them in a row have not lowered the map (at most
+/// max_polishes); then a block of check_interval sweeps. Until the checks after a polish
+/// were local, each cost a whole pass and at most four polishes paid. The warm start's worst contacts are a tail whose error grows with the
 /// sample (its largest |min(y_j, g_j)| over the mean impulse 6e-3, 1.2e-2, 2.1e-2 and 4.8e-2
 /// at 1000, 4000, 16 000 and 64 000 grains, while its root mean square stays near 6e-4):
 /// whole sweeps spent on that tail are what made the sweeps grow with the width, and the
@@ -60,8 +62,13 @@ namespace tribo::dem
     static constexpr unsigned int polish_passes = 3;
     /// ... and their neighbours up to this many rings away in A', ...
     static constexpr unsigned int polish_rings = 2;
-    /// ... at most this many polishes (each followed by a check) between two blocks of sweeps,
-    static constexpr unsigned int polishes_per_check = 4;
+    /// ... polishes (each followed by a check of the rows it changed) go on between two
+    /// blocks of sweeps until this many in a row have not lowered the map below its lowest
+    /// since the block (a polish that leaves the worst contact where it was still repairs
+    /// others: stopping at the first such polish made more passes, docs/performance.md), ...
+    static constexpr unsigned int polish_patience = 32;
+    /// ... and at most this many of them,
+    static constexpr unsigned int max_polishes = 1024;
     /// ... and only while those contacts are at most this fraction of all.
     static constexpr double polish_fraction = 0.05;
     /// The report's iterations are the sweeps plus the whole checks (one product each); the
