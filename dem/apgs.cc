@@ -91,7 +91,7 @@ namespace tribo::dem
           const Eigen::Index s = slab_of(j);
           for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a && separate; ++a)
             separate = std::abs(slab_of(a.row()) - s) <= 1;
-          if (scaled.U.cols() > 0 && scaled.U.row(j).squaredNorm() > 0)
+          if (op.has_low_rank(j))
             {
               separate = separate && (low_rank_slab < 0 || low_rank_slab == s);
               low_rank_slab = s;
@@ -139,10 +139,7 @@ namespace tribo::dem
     // rows of the polished columns of A', and the walls' low-rank rows when a polished
     // contact is one of them. All of it costs O(the polished contacts + the chunks).
     std::vector<char>         marked(n, 0), affected(n, 0);
-    std::vector<Eigen::Index> local, affected_rows, low_rank_rows;
-    for (Eigen::Index j = 0; j < n; ++j)
-      if (scaled.U.cols() > 0 && scaled.U.row(j).squaredNorm() > 0)
-        low_rank_rows.push_back(j);
+    std::vector<Eigen::Index> local, affected_rows;
     auto affect = [&](Eigen::Index j) {
       if (!affected[j])
         {
@@ -196,20 +193,21 @@ namespace tribo::dem
           for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a; ++a)
             affect(a.row());
           affect(j);
-          wall = wall || (scaled.U.cols() > 0 && scaled.U.row(j).squaredNorm() > 0);
+          wall = wall || op.has_low_rank(j);
         }
       if (wall)
-        for (const Eigen::Index j : low_rank_rows)
+        for (const Eigen::Index j : op.low_rank_row_list())
           affect(j);
       return true;
     };
     // The check after a polish: the chunks that hold an affected row are recomputed, the
     // others keep their sums (y did not change there): the bits of a whole check, at the
     // polish's cost. Not counted as a pass.
-    std::vector<char> dirty(chunk_count(n), 0);
+    std::vector<char>         dirty(chunk_count(n), 0);
+    std::vector<Eigen::Index> chunks; // the dirty chunks, in the order found
     auto recheck = [&](const Eigen::VectorXd &y) {
       op.set_vector(y);
-      std::vector<Eigen::Index> chunks;
+      chunks.clear();
       for (const Eigen::Index j : affected_rows)
         if (!dirty[j / chunk_size])
           {
@@ -232,7 +230,7 @@ namespace tribo::dem
     // Polishes since the last block of sweeps, and since the lowest map among them.
     unsigned int polished = 0, since_lowest = 0;
     double       lowest   = INFINITY;
-    double          map      = relative_map(y);
+    double       map      = relative_map(y);
     while (map > prm.residual_target)
       {
         if (report.iterations >= prm.max_iterations)

@@ -33,8 +33,8 @@
 /// at the polish's cost, not counted as a pass since 2026-11-27, eighth session). Polishes
 /// go on until polish_patience of them in a row have not lowered the map (at most
 /// max_polishes); then a block of check_interval sweeps. Until the checks after a polish
-/// were local, each cost a whole pass and at most four polishes paid. The warm start's worst contacts are a tail whose error grows with the
-/// sample (its largest |min(y_j, g_j)| over the mean impulse 6e-3, 1.2e-2, 2.1e-2 and 4.8e-2
+/// were local, each cost a whole pass and at most four polishes paid. The warm start's
+/// worst contacts are a tail whose error grows with the sample (its largest |min(y_j, g_j)| over the mean impulse 6e-3, 1.2e-2, 2.1e-2 and 4.8e-2
 /// at 1000, 4000, 16 000 and 64 000 grains, while its root mean square stays near 6e-4):
 /// whole sweeps spent on that tail are what made the sweeps grow with the width, and the
 /// polish works on it alone (docs/performance.md, "APGS's local polish").

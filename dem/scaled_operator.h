@@ -72,6 +72,10 @@ namespace tribo::dem
   public:
     explicit ScaledOperator(const FrictionlessProblem::Scaled &p);
 
+    /// The rows with low-rank entries (the walls' contacts), increasing.
+    const std::vector<Eigen::Index> &low_rank_row_list() const { return low_rank_rows; }
+    /// Whether row @p j has low-rank entries.
+    bool has_low_rank(Eigen::Index j) const { return low_rank_start[j + 1] > low_rank_start[j]; }
     /// Prepare the row products with @p v (computes U'^T v); call before row_times(v, .).
     void set_vector(const Eigen::VectorXd &v);
     /// After v_j changed by @p change in place: keep U'^T v current (Gauss-Seidel sweeps,
