@@ -10,14 +10,13 @@
 
 namespace tribo::dem
 {
-  std::vector<Contact> ContactDetector::detect(const ParticleSystem &system,
-                                               const std::vector<Vec2> &centres, double distance,
-                                               unsigned int threads, const std::vector<Vec2> &motion)
+  void ContactDetector::detect(const ParticleSystem &system, const std::vector<Vec2> &centres, double distance,
+                               unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts)
   {
-    std::vector<Contact> contacts;
-    const std::size_t    n = centres.size();
+    contacts.clear();
+    const std::size_t n = centres.size();
     if (n < 2)
-      return contacts;
+      return;
     if (!motion.empty() && motion.size() != n)
       throw RunError("contact detection: " + std::to_string(motion.size()) + " disc motions for " +
                      std::to_string(n) + " discs");
@@ -158,22 +157,20 @@ namespace tribo::dem
     if (n_chunks == 1)
       {
         detect_rows(0, ny, contacts);
-        return contacts;
+        return;
       }
-    std::vector<std::vector<Contact>> found(n_chunks);
+    chunk_contacts.resize(n_chunks);
     dealii::parallel::apply_to_subranges(
       0L, n_chunks,
       [&](long begin, long end) {
         for (long k = begin; k < end; ++k)
-          detect_rows(ny * k / n_chunks, ny * (k + 1) / n_chunks, found[k]);
+          {
+            chunk_contacts[k].clear();
+            detect_rows(ny * k / n_chunks, ny * (k + 1) / n_chunks, chunk_contacts[k]);
+          }
       },
       1);
-    std::size_t total = 0;
-    for (const auto &f : found)
-      total += f.size();
-    contacts.reserve(total);
-    for (const auto &f : found)
+    for (const auto &f : chunk_contacts)
       contacts.insert(contacts.end(), f.begin(), f.end());
-    return contacts;
   }
 } // namespace tribo::dem

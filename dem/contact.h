@@ -67,15 +67,26 @@ namespace tribo::dem
     /// discs then meet their new neighbours as contacts with a positive gap, which the laws
     /// close exactly, instead of passing into them undetected (docs/laws.md, "Detection"),
     /// as long as the relative motion is at most max_motion_reach largest radii.
+    /// Into @p contacts (cleared; its capacity is kept, so that a caller detecting every
+    /// step does not allocate and fault in tens of MB of fresh pages each time at 64 000 grains).
+    void detect(const ParticleSystem &system, const std::vector<Vec2> &centres, double distance,
+                unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts);
+    /// The same, returned.
     std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &centres,
                                 double distance, unsigned int threads = 1,
-                                const std::vector<Vec2> &motion = {});
+                                const std::vector<Vec2> &motion = {})
+    {
+      std::vector<Contact> contacts;
+      detect(system, centres, distance, threads, motion, contacts);
+      return contacts;
+    }
     /// The motions widen the cells by at most this many largest radii (at most twice the
     /// cells without motion, four times the candidate pairs); pairs closed by a larger
     /// relative motion are not looked for.
     static constexpr double max_motion_reach = 2;
 
   private:
-    std::vector<unsigned int> cell_start, cell_items, cell_of;
+    std::vector<unsigned int>         cell_start, cell_items, cell_of;
+    std::vector<std::vector<Contact>> chunk_contacts; ///< the threads' chunks, kept between calls
   };
 } // namespace tribo::dem

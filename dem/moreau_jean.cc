@@ -93,7 +93,8 @@ namespace tribo::dem
     const auto step_start = std::chrono::steady_clock::now();
     StepReport report;
     predict(system, h);
-    set_up_local_problems(system, detect(system, h, report), h, report);
+    detect(system, h, report);
+    set_up_local_problems(system, h, report);
 
     auto phase         = std::chrono::steady_clock::now();
     report.solver      = solve_contacts(h);
@@ -144,7 +145,7 @@ namespace tribo::dem
 
   }
 
-  std::vector<Contact> MoreauJean::detect(const ParticleSystem &system, double h, StepReport &report)
+  void MoreauJean::detect(const ParticleSystem &system, double h, StepReport &report)
   {
     // Disc pairs at the predicted configuration.
     centres.resize(system.discs.size());
@@ -167,7 +168,7 @@ namespace tribo::dem
         disc_motion[d] = lookahead * h * Vec2(v.x() - v.z() * offset.y(), v.y() + v.z() * offset.x());
       }
     auto                 phase = std::chrono::steady_clock::now();
-    std::vector<Contact> found = detector.detect(system, centres, distance, solver.parameters().threads, disc_motion);
+    detector.detect(system, centres, distance, solver.parameters().threads, disc_motion, found);
     report.time_detection      = seconds_since(phase);
 
     // The boundary body: free state, predicted nodes, half-disc contacts.
@@ -194,16 +195,14 @@ namespace tribo::dem
         report.n_boundary_contacts = on_boundary.size();
         found.insert(found.end(), on_boundary.begin(), on_boundary.end());
       }
-
-    return found;
   }
 
-  void MoreauJean::set_up_local_problems(const ParticleSystem &system, std::vector<Contact> found, double h,
-                                         StepReport &report)
+  void MoreauJean::set_up_local_problems(const ParticleSystem &system, double h, StepReport &report)
   {
-    // Geometry of H, the own Delassus blocks, law terms, free velocities, warm start.
-    current.clear();
-    current.reserve(found.size());
+    // Geometry of H, the own Delassus blocks, law terms, free velocities, warm start;
+    // the contacts to solve are compacted in place and become current (found takes the last
+    // step's buffer: neither is copied nor allocated anew).
+    std::size_t kept = 0;
     for (Contact &c : found)
       {
         const Vec2 t(-c.normal.y(), c.normal.x());
@@ -229,8 +228,10 @@ namespace tribo::dem
         c.compliance       = terms.compliance;
         c.u_free           = state.local_velocity(c);
         c.r                = previous_impulse.find(c.key());
-        current.push_back(c);
+        found[kept++]      = c;
       }
+    found.resize(kept);
+    current.swap(found);
     report.n_contacts = current.size();
     for (const Contact &c : current)
       if (c.r.x() != 0 || c.r.y() != 0)

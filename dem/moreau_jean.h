@@ -150,12 +150,11 @@ namespace tribo::dem
     /// x + (1 - theta) h v (x_pred, angle_pred), into state and the scratch below.
     void predict(const ParticleSystem &system, double h);
     /// Disc pairs, and the half-discs of an attached boundary body (after its own
-    /// prediction), closer than the detection distance at the predicted configuration.
-    std::vector<Contact> detect(const ParticleSystem &system, double h, StepReport &report);
-    /// The local problems of @p found into current: arms (rows of H), own Delassus blocks,
+    /// prediction), closer than the detection distance at the predicted configuration, into found.
+    void detect(const ParticleSystem &system, double h, StepReport &report);
+    /// The local problems of found into current: arms (rows of H), own Delassus blocks,
     /// law terms, free local velocities, warm-start impulses applied to state.
-    void set_up_local_problems(const ParticleSystem &system, std::vector<Contact> found, double h,
-                               StepReport &report);
+    void set_up_local_problems(const ParticleSystem &system, double h, StepReport &report);
     /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
     /// (returned, m); stores the loaded contacts' impulses as the next warm start.
     double measure_gaps(double h, StepReport &report);
@@ -183,6 +182,7 @@ namespace tribo::dem
     NlgsSolver               predictor; ///< the active set's predictor sweeps
     double                   distance;
     ContactDetector          detector;
+    std::vector<Contact>     found;   ///< detect()'s pairs, kept between steps with their capacity
     std::vector<Contact>     current;
     WarmStart                previous_impulse;
     std::vector<WarmStart::Entry> next_impulse; ///< this step's, before it becomes the previous
