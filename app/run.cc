@@ -28,8 +28,10 @@ namespace tribo::app
 
   bool may_change_on_resume(const std::string &entry)
   {
+    // The prediction depth says only how the contact solve's prediction of a particle body
+    // is computed (its real advances are the same), as the Solver entries do.
     return entry.rfind("Solver/", 0) == 0 || entry.rfind("Output/", 0) == 0 ||
-           entry == "Simulation/End time";
+           entry == "Simulation/End time" || entry == "Shear cell/Upper body prediction depth";
   }
 
   std::string resume_changes(const std::map<std::string, std::string> &saved,
@@ -50,7 +52,8 @@ namespace tribo::app
         if (!may_change_on_resume(entry))
           throw InputError("--resume " + dir + ": entry '" + entry + "' is '" + value +
                            "' in the case but '" + before + "' in the checkpoint; a resumed run "
-                           "may change only Solver/*, Output/* and Simulation/End time");
+                           "may change only Solver/*, Output/*, Simulation/End time and Shear cell/Upper body "
+                           "prediction depth");
         changed += (changed.empty() ? "" : ", ") + entry + " " + before + " -> " + value;
       }
     return (changed.empty() ? "" : "; changed: " + changed) +

@@ -98,6 +98,16 @@ namespace tribo::coupling
                       "2 / omega_max of the stiffest bond (in (0, 0.5]): smaller is more accurate and "
                       "slower. On the 120-disc cell at the fem body's step the energy books close to "
                       "0.03 % at 0.05 and to 0.17 % at 0.2, which is 3.5 times faster (docs/first_bodies.md).");
+    prm.declare_entry("Upper body prediction depth", "0", Double(),
+                      "sph and mlp upper bodies: the trial advances of each contact step (the chain's free "
+                      "motion the contact solve predicts, and the columns of its compliance) run on the "
+                      "bottom rows within this many wave reaches c_p h of the chain, the rows above them "
+                      "within the interaction's reach carried at their start velocities, instead of on the "
+                      "whole body (>= 0; 0: the whole body). The real advance with the solved impulses is "
+                      "always the whole body's, so the books are unchanged; a strip too thin shows as a "
+                      "larger linearisation miss. At 3 the prediction is the whole body's to 1e-5 and the "
+                      "paper-size mlp body costs 0.62 times as much per step (docs/first_bodies.md, "
+                      "\"Trial advances on a strip\"). May change on --resume.");
     prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
                       "Degree p of the fem upper body's Q_p elements.");
     prm.declare_entry("Upper body modes", "20", Integer(0),
@@ -132,6 +142,8 @@ namespace tribo::coupling
                                       [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
     p.verlet_fraction = f.get_checked(entry("Upper body Verlet fraction"), [](double v) { return v > 0 && v <= 0.5; },
                                       "a fraction of the stability limit in (0, 0.5]");
+    p.prediction_depth = f.get_checked(entry("Upper body prediction depth"), non_negative,
+                                       "a depth >= 0 in wave reaches c_p h");
     p.youngs_modulus = f.get_checked(entry("Upper body Young's modulus"), positive, "a positive modulus in Pa");
     p.poisson_ratio  = f.get_checked(entry("Upper body Poisson ratio"), [](double v) { return v > -1 && v < 0.5; },
                                      "a Poisson ratio in (-1, 0.5)");

@@ -73,6 +73,10 @@ namespace tribo::coupling
     /// Velocity-Verlet step of the mlp body over its stability limit 2 / omega_max (the
     /// largest step that divides the contact step and is at most this fraction of it).
     double       verlet_fraction = 0.05;
+    /// Depth of the strip of bottom rows on which a particle body's trial advances of a step
+    /// (the free prediction, the compliance's columns) run, in wave reaches c_p h (sph, mlp);
+    /// 0: the whole body (ParticleFirstBody::advance_strip()).
+    double       prediction_depth = 0;
     /// The case subsection the body's entries were read from: messages name them
     /// through it.
     ParameterSection section;

@@ -148,6 +148,50 @@ namespace tribo::coupling
       }
       double total_dissipation() const override { return dissipation_offset + integrator->bath_work(); }
 
+      /// The strip: the particles of the bottom `rows` rows plus the row above them (indices
+      /// [0, (rows + 1) nx), rows upwards), that row held (fix_xy: it keeps its start velocity
+      /// and moves with it, no force). A disturbance from the held row reaches the chain
+      /// after rows dy / c_p; rows = ceil(depth c_p h / dy) makes that depth contact steps.
+      bool advance_strip(double h, const std::vector<dem::Vec2> &chain_force,
+                         std::vector<dem::Vec2> &chain_position) override
+      {
+        const double dy   = 0.5 * std::sqrt(3.0) * spacing;
+        const long   rows = prm.prediction_depth > 0 ? std::lround(std::ceil(prm.prediction_depth * p_wave_speed(prm) * h / dy)) : 0;
+        if (rows == 0 || rows + 1 >= ny)
+          return false;
+        if (std::abs(h - step_built) > 1e-12 * step_built)
+          build_integrator(h);
+        const unsigned int nx = n_nodes(), n = (rows + 1) * nx;
+        if (strip.size() != n || strip_gamma != gamma || strip_h != h)
+          {
+            strip = mlp::Particles{};
+            for (unsigned int p = 0; p < n; ++p)
+              strip.add(particles.position[p], particles.mass[p], particles.group[p]);
+            for (unsigned int p = rows * nx; p < n; ++p)
+              strip.fixed[p] = mlp::fix_xy;
+            mlp::LangevinParameters lp;
+            lp.time_step     = h / substeps_per_step;
+            lp.damping       = gamma * particles.mass[0];
+            strip_integrator = std::make_unique<mlp::LangevinIntegrator>(strip_forces, strip, lp);
+            strip_gamma      = gamma;
+            strip_h          = h;
+          }
+        for (unsigned int p = 0; p < n; ++p)
+          {
+            strip.position[p]       = particles.position[p];
+            strip.velocity[p]       = particles.velocity[p];
+            strip.external_force[p] = dem::Vec2::Zero();
+          }
+        for (std::size_t i = 0; i < chain_force.size(); ++i)
+          strip.external_force[chain[i]] = chain_force[i];
+        strip_integrator->invalidate_forces();
+        strip_integrator->run(strip, box, substeps_per_step);
+        chain_position.resize(chain.size());
+        for (std::size_t i = 0; i < chain.size(); ++i)
+          chain_position[i] = strip.position[chain[i]];
+        return true;
+      }
+
     private:
       static mlp::InteractionParameters interaction(const FirstBodyParameters &p)
       {
@@ -179,6 +223,10 @@ namespace tribo::coupling
       }
 
       mutable mlp::ForceField                  forces;
+      mlp::ForceField                          strip_forces{interaction(prm)}; ///< of the strip (advance_strip())
+      mlp::Particles                           strip;
+      std::unique_ptr<mlp::LangevinIntegrator> strip_integrator;
+      double                                   strip_gamma = -1, strip_h = 0;
       mlp::Particles                           particles;
       mlp::Box                                 box;
       std::unique_ptr<mlp::LangevinIntegrator> integrator;

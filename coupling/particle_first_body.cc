@@ -35,9 +35,8 @@ namespace tribo::coupling
     G = Eigen::MatrixXd::Zero(2 * n, 2 * n);
   }
 
-  dem::Vec2 ParticleFirstBody::unwrapped(unsigned int i) const
+  dem::Vec2 ParticleFirstBody::unwrapped(unsigned int i, dem::Vec2 x) const
   {
-    dem::Vec2    x  = position(chain[i]);
     const double dx = x.x() - reference_x[i];
     x.x()           = reference_x[i] + dx - prm.length * std::round(dx / prm.length);
     return x;
@@ -49,6 +48,24 @@ namespace tribo::coupling
     for (unsigned int i = 0; i < chain.size(); ++i)
       d.segment<2>(2 * i) = unwrapped(i) - start[i];
     return d;
+  }
+
+  Eigen::VectorXd ParticleFirstBody::trial_displacement(double h, double load, const std::vector<dem::Vec2> &force)
+  {
+    if (advance_strip(h, force, strip_chain))
+      {
+        Eigen::VectorXd d(2 * chain.size());
+        for (unsigned int i = 0; i < chain.size(); ++i)
+          d.segment<2>(2 * i) = unwrapped(i, strip_chain[i]) - start[i];
+        engine_free = false;
+        return d;
+      }
+    if (!engine_at_start)
+      restore(start_state);
+    substeps        = advance(h, load, force);
+    engine_at_start = false;
+    engine_free     = false;
+    return chain_displacement();
   }
 
   double ParticleFirstBody::top_load(double h) const
@@ -90,13 +107,10 @@ namespace tribo::coupling
         {
           const double eps = prm.pressure > 0 ? prm.pressure * spacing * h
                                               : 2 * mass(chain[j]) * compliance_probe * spacing / h;
-          restore(start_state);
           force[j][c] = eps / h;
-          advance(h, load, force);
-          D.col(2 * j + c) = (chain_displacement() - free_displacement) / eps;
+          D.col(2 * j + c) = (trial_displacement(h, load, force) - free_displacement) / eps;
           force[j][c] = 0;
         }
-    engine_free = false;
     asymmetry   = (D - D.transpose()).norm() / D.norm();
     G             = positive_part(D) / (prm.theta * h);
     compliance_h  = h;
@@ -125,12 +139,12 @@ namespace tribo::coupling
       top_start_y[q] = position(top[q]).y();
     dissipation_at_start = total_dissipation();
     start_state          = snapshot();
+    engine_at_start      = true;
     step_h               = h;
     step_load            = top_load(h);
 
-    substeps          = advance(h, step_load, std::vector<dem::Vec2>(n, dem::Vec2::Zero()));
-    free_displacement = chain_displacement();
-    engine_free       = true;
+    free_displacement = trial_displacement(h, step_load, std::vector<dem::Vec2>(n, dem::Vec2::Zero()));
+    engine_free       = !engine_at_start; // the whole body's free end state, kept if no impulse comes
     // v_b: the chain's mean velocity over the last step (file comment).
     const double th = prm.theta;
     for (unsigned int i = 0; i < n; ++i)
@@ -155,14 +169,16 @@ namespace tribo::coupling
       R.segment<2>(2 * i) = impulses[i];
     if (R.squaredNorm() > 0 || !engine_free)
       {
-        restore(start_state);
+        if (!engine_at_start)
+          restore(start_state);
         std::vector<dem::Vec2> force(n);
         for (unsigned int i = 0; i < n; ++i)
           force[i] = R.segment<2>(2 * i) / h;
         substeps = advance(h, step_load, force);
       }
-    engine_free = false;
-    in_step     = false;
+    engine_free     = false;
+    engine_at_start = false;
+    in_step         = false;
 
     // The books of the real step.
     load_work = 0;

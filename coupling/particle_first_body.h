@@ -129,6 +129,18 @@ namespace tribo::coupling
     virtual void load_engine(CheckpointIn &ar)        = 0;
     /// Drop the engine's compaction damping; false if it had none (left).
     virtual bool stop_damping() = 0;
+    /// The trial advances of a step (the free prediction and the compliance's columns) on
+    /// the body's bottom rows alone (FirstBodyParameters::prediction_depth): from the
+    /// engine's current state, which it leaves unchanged, advance a copy of the rows within
+    /// that depth, the row above them carried at its start velocity, by @p h with
+    /// @p chain_force[i] (N/m) on chain particle i; @p chain_position[i] gets its end
+    /// position (m, wrapped). False when the engine has no such strip (the depth is 0 or
+    /// reaches the top): the whole body is advanced instead.
+    virtual bool advance_strip(double /*h*/, const std::vector<dem::Vec2> & /*chain_force*/,
+                               std::vector<dem::Vec2> & /*chain_position*/)
+    {
+      return false;
+    }
 
     /// To be called by the engine's constructor once its particles exist: the chain
     /// (bottom row, any order) and the loaded top row.
@@ -139,9 +151,15 @@ namespace tribo::coupling
     explicit ParticleFirstBody(const FirstBodyParameters &p) : prm(p) {}
 
   private:
-    dem::Vec2 unwrapped(unsigned int i) const; ///< chain particle i, near its reference x
+    /// Chain particle i at @p x (wrapped), unwrapped near its reference x.
+    dem::Vec2 unwrapped(unsigned int i, dem::Vec2 x) const;
+    dem::Vec2 unwrapped(unsigned int i) const { return unwrapped(i, position(chain[i])); }
     /// Chain displacements since the start of the step, flattened (2i: x, 2i + 1: y), m.
     Eigen::VectorXd chain_displacement() const;
+    /// The chain displacements of a trial advance from S_0 by @p h with @p force on the
+    /// chain: on the engine's strip (advance_strip(), the engine stays at S_0), else the
+    /// whole body (restored to S_0 first if it has left it).
+    Eigen::VectorXd trial_displacement(double h, double load, const std::vector<dem::Vec2> &force);
     /// Top load per top particle at mid-step, N/m (compressive: < 0).
     double top_load(double h) const;
     /// D by finite differences from the saved state; leaves the engine off S_0's step.
@@ -162,6 +180,8 @@ namespace tribo::coupling
     std::string            start_state;        ///< S_0 (save_engine())
     bool                   in_step = false;    ///< between predict() and finalize()
     bool                   engine_free = false; ///< the engine holds the free end state
+    bool                   engine_at_start = false; ///< the engine holds S_0 (trials on its strip)
+    std::vector<dem::Vec2> strip_chain;         ///< chain end positions of a strip trial, m
     bool                   stale = true;        ///< rebuild G at the next predict()
     double                 compliance_h = 0;    ///< step G was built for, s
     double                 step_h = 0, step_load = 0, load_work = 0, dissipated = 0, extra_work = 0;

@@ -55,6 +55,9 @@ namespace tribo::coupling
           throw std::logic_error("SPH first body: lattice rows of " + std::to_string(bottom.size()) + " and " +
                                  std::to_string(top_row.size()) + " particles, expected " + std::to_string(nx));
         set_rows(bottom, top_row);
+        row_of.resize(solver.state.size());
+        for (unsigned int i = 0; i < solver.state.size(); ++i)
+          row_of[i] = std::lround((solver.state.x[i][1] - p.bottom) / spacing);
 
         sph::ImposedVelocity<2> hold;
         hold.particles  = top_row;
@@ -145,6 +148,66 @@ namespace tribo::coupling
         return dissipation_offset + solver.damping_dissipation() + solver.viscous_heat();
       }
 
+      /// The strip: the particles of the bottom `rows` rows and of the `held` rows above
+      /// them, the kernel's support 2 h_s, which keep their start velocities (imposed), so
+      /// that every moving particle has its whole neighbourhood. A disturbance from the held
+      /// rows reaches the chain after rows s / c_p; rows = ceil(depth c_p h / s) makes that
+      /// depth contact steps. The strip takes its own adaptive steps.
+      bool advance_strip(double h, const std::vector<dem::Vec2> &chain_force,
+                         std::vector<dem::Vec2> &chain_position) override
+      {
+        const long rows = prm.prediction_depth > 0 ? std::lround(std::ceil(prm.prediction_depth * p_wave_speed(prm) * h / spacing)) : 0;
+        const long held = std::lround(std::ceil(2 * prm.smoothing_ratio));
+        if (rows == 0 || rows + held >= ny)
+          return false;
+        const auto &full = solver.state;
+        if (rows != strip_rows)
+          {
+            strip = std::make_unique<sph::Solver<2>>(solver.materials(), solver.parameters());
+            strip_particles.clear();
+            std::vector<unsigned int> index_in_strip(full.size(), 0);
+            for (unsigned int i = 0; i < full.size(); ++i)
+              if (row_of[i] < rows + held)
+                {
+                  index_in_strip[i] = strip_particles.size();
+                  strip_particles.push_back(i);
+                  if (row_of[i] >= rows)
+                    strip->imposed.push_back({{index_in_strip[i]}, {}, 3, {}, {}});
+                }
+            strip->state = sph::ParticleState<2>{};
+            for (const unsigned int i : strip_particles)
+              strip->state.add(full.x[i], full.v[i], full.mass[i], full.rho[i], full.h[i], full.material[i], full.body[i]);
+            for (const unsigned int p : chain)
+              strip->external.push_back({{index_in_strip[p]}, {}, 0});
+            strip_chain_index.resize(chain.size());
+            for (std::size_t q = 0; q < chain.size(); ++q)
+              strip_chain_index[q] = index_in_strip[chain[q]];
+            strip_rows = rows;
+          }
+        auto &st = strip->state;
+        for (std::size_t k = 0; k < strip_particles.size(); ++k)
+          {
+            const unsigned int i = strip_particles[k];
+            st.x[k]   = full.x[i];
+            st.v[k]   = full.v[i];
+            st.rho[k] = full.rho[i];
+            st.e[k]   = full.e[i];
+            st.S[k]   = full.S[i];
+            st.h[k]   = full.h[i];
+          }
+        for (auto &iv : strip->imposed)
+          iv.velocity = st.v[iv.particles[0]];
+        for (std::size_t q = 0; q < chain.size(); ++q)
+          strip->external[q].force = Tensor<1, 2>({chain_force[q].x(), chain_force[q].y()});
+        strip->damping = solver.damping;
+        strip->time    = solver.time;
+        strip->advance_to(solver.time + h);
+        chain_position.resize(chain.size());
+        for (std::size_t q = 0; q < chain.size(); ++q)
+          chain_position[q] = {st.x[strip_chain_index[q]][0], st.x[strip_chain_index[q]][1]};
+        return true;
+      }
+
     private:
       static sph::SolverParameters parameters(const FirstBodyParameters &p)
       {
@@ -154,6 +217,10 @@ namespace tribo::coupling
       }
 
       sph::Solver<2> solver;
+      std::vector<long> row_of; ///< lattice row of each particle (0: the chain)
+      std::unique_ptr<sph::Solver<2>> strip; ///< advance_strip()'s body
+      std::vector<unsigned int> strip_particles, strip_chain_index; ///< full indices; the chain's in the strip
+      long           strip_rows = 0;
       double         spacing = 0;
       long           ny      = 0;
       double         dissipation_offset = 0; ///< J/m, restored from a checkpoint

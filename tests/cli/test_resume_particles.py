@@ -95,8 +95,9 @@ class ResumeParticles(TempDirTestCase):
         self.assertEqual(r.returncode, 2, r.stderr)
         self.assertEqual(r.stderr.strip(),
                          "error: --resume out: entry '%s' is '%s' in the case but '%s' in the "
-                         "checkpoint; a resumed run may change only Solver/*, Output/* and "
-                         "Simulation/End time" % (entry, value, saved))
+                         "checkpoint; a resumed run may change only Solver/*, Output/*, "
+                         "Simulation/End time and Shear cell/Upper body prediction depth"
+                         % (entry, value, saved))
         self.assertTrue(os.path.exists(os.path.join(self.tmp, "out", "checkpoint.bin")),
                         "a refused resumption keeps the checkpoint")
 

@@ -26,7 +26,8 @@ namespace
     dealii::ParameterHandler prm;
     ParameterFile            file{prm};
 
-    explicit Case(const std::string &body)
+    /// @p prediction_depth: also declare "Shear cell/Upper body prediction depth".
+    explicit Case(const std::string &body, bool prediction_depth = false)
     {
       prm.enter_subsection("Simulation");
       prm.declare_entry("End time", "1e-6", dealii::Patterns::Double(0));
@@ -37,6 +38,8 @@ namespace
       prm.enter_subsection("Shear cell");
       prm.declare_entry("Pressure", "1e8", dealii::Patterns::Double(0));
       prm.declare_entry("New entry", "0.5", dealii::Patterns::Double(0));
+      if (prediction_depth)
+        prm.declare_entry("Upper body prediction depth", "0", dealii::Patterns::Double(0));
       prm.leave_subsection();
       // One file per test and process: ctest runs these tests concurrently.
       const std::string name = ::testing::TempDir() + "resume_case_" +
@@ -84,12 +87,22 @@ TEST(ResumeChanges, SolverAndEndTimeMayChangeAndAreLogged)
             "; changed: Simulation/End time 1e-6 -> 2e-6, Solver/Tolerance 1e-4 -> 5e-4");
 }
 
+TEST(ResumeChanges, TheParticleBodysPredictionDepthMayChange)
+{
+  auto with_depth = saved;
+  with_depth["Shear cell/New entry"] = "0.5";
+  with_depth["Shear cell/Upper body prediction depth"] = "0";
+  Case c("subsection Shear cell\n  set Upper body prediction depth = 3\nend\n", true);
+  EXPECT_EQ(app::resume_changes(with_depth, c.file, "out"), "; changed: Shear cell/Upper body prediction depth 0 -> 3");
+}
+
 TEST(ResumeChanges, TheLoadingMayNotChange)
 {
   Case c("subsection Shear cell\n  set Pressure = 2e8\nend\n");
   EXPECT_EQ(message(saved, c),
             "--resume out: entry 'Shear cell/Pressure' is '2e8' in the case but '1e8' in the "
-            "checkpoint; a resumed run may change only Solver/*, Output/* and Simulation/End time");
+            "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time and "
+            "Shear cell/Upper body prediction depth");
 }
 
 TEST(ResumeChanges, AnEntryNewerThanTheCheckpointIsAcceptedAtItsDefault)
@@ -105,5 +118,6 @@ TEST(ResumeChanges, AnEntryNewerThanTheCheckpointIsRefusedWhenTheCaseSetsIt)
   Case c("subsection Shear cell\n  set New entry = 0.7\nend\n");
   EXPECT_EQ(message(saved, c),
             "--resume out: entry 'Shear cell/New entry' is '0.7' in the case but '(absent)' in the "
-            "checkpoint; a resumed run may change only Solver/*, Output/* and Simulation/End time");
+            "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time and "
+            "Shear cell/Upper body prediction depth");
 }
