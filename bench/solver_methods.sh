@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Contact solvers side by side from one checkpoint: each setting resumes a copy of the run
 # for STEPS steps and prints its time per step (summary.json "timing": the steps alone,
-# no start-up), the solver's share, iterations per step (NLGS sweeps, predictor sweeps
+# no start-up), the solver's and the contact detection's shares, iterations per step (NLGS sweeps, predictor sweeps
 # plus MPRGP products), CHOLMOD factorisations per step, the law residual reached (mean
 # and max over the steps, docs/laws.md), the worst overlap over the smallest radius, and
 # mean mu +/- its batch-means standard error (10 contiguous batches, the estimator of
@@ -55,9 +55,9 @@ try:
     dst = os.path.join(tmp, "run")
     step0, _ = resume(1e-12, dst, [])  # logs the checkpoint's step, runs nothing
     print(f"checkpoint {src} at step {step0}, {steps} steps per setting")
-    print("| setting | ms per step | solver ms | iterations per step | factorisations per step "
+    print("| setting | ms per step | solver ms | detection ms | iterations per step | factorisations per step "
           "| law residual mean / max | worst overlap / r_min | mu |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     for setting in settings:
         extra = [s.strip() for s in re.split(r"\s+(?=[A-Z][A-Za-z ]*/)", setting.strip()) if s.strip()]
         _, s = resume((step0 + steps) * h, dst, extra)
@@ -75,7 +75,7 @@ try:
         mu = np.array([float(r["mu"]) for r in rows])
         batches = np.array([b.mean() for b in np.array_split(mu, 10)])
         mu_stderr = batches.std(ddof=1) / np.sqrt(len(batches))
-        print(f"| {setting} | {t['step_mean_s'] * 1e3:.1f} | {t['nlgs_mean_s'] * 1e3:.1f} "
+        print(f"| {setting} | {t['step_mean_s'] * 1e3:.1f} | {t['nlgs_mean_s'] * 1e3:.1f} | {t['detection_mean_s'] * 1e3:.1f} "
               f"| {t['nlgs_sweeps_mean']:.1f} | {factorizations:.1f} "
               f"| {sum(lr) / len(lr):.2e} / {max(lr):.2e} "
               f"| {overlap / r_min if r_min else float('nan'):.2f} | {mu.mean():.4f} +/- {mu_stderr:.4f} |", flush=True)
