@@ -169,10 +169,7 @@ namespace tribo::coupling
               strip.add(particles.position[p], particles.mass[p], particles.group[p]);
             for (unsigned int p = rows * nx; p < n; ++p)
               strip.fixed[p] = mlp::fix_xy;
-            mlp::LangevinParameters lp;
-            lp.time_step     = h / substeps_per_step;
-            lp.damping       = gamma * particles.mass[0];
-            strip_integrator = std::make_unique<mlp::LangevinIntegrator>(strip_forces, strip, lp);
+            strip_integrator = std::make_unique<mlp::LangevinIntegrator>(strip_forces, strip, integrator_parameters(h));
             strip_gamma      = gamma;
             strip_h          = h;
           }
@@ -207,15 +204,22 @@ namespace tribo::coupling
         return ip;
       }
 
+      /// The sub-steps of a contact step @p h (substeps_per_step of them), at T = 0 with the
+      /// compaction damping gamma.
+      mlp::LangevinParameters integrator_parameters(double h) const
+      {
+        mlp::LangevinParameters lp;
+        lp.time_step = h / substeps_per_step;
+        lp.damping   = gamma * particles.mass[0];
+        return lp;
+      }
+
       /// A Verlet step of at most prm.verlet_fraction of the stability limit that divides @p h.
       void build_integrator(double h)
       {
         const double carried = integrator ? total_dissipation() : dissipation_offset;
         substeps_per_step     = std::max(1.0, std::ceil(h / (prm.verlet_fraction * 2 / omega_max)));
-        mlp::LangevinParameters lp;
-        lp.time_step = h / substeps_per_step;
-        lp.damping   = gamma * particles.mass[0];
-        integrator   = std::make_unique<mlp::LangevinIntegrator>(forces, particles, lp);
+        integrator            = std::make_unique<mlp::LangevinIntegrator>(forces, particles, integrator_parameters(h));
         dissipation_offset = carried;
         step_built         = h;
         if (std::isnan(reference_energy))
