@@ -25,6 +25,12 @@
 ///   theta = 1/2) and heat the chain; d_free / h as v_b would put every predicted contact
 ///   as deep into overlap as the unsupported chain falls in half a step
 ///   (docs/first_bodies.md, "Kinematics");
+/// - trial advances on a strip (FirstBodyParameters::prediction_depth > 0): the free
+///   prediction and the compliance's columns advance only a copy of the bottom rows within
+///   depth wave reaches c_p h of the chain (advance_strip()), the rows above them within
+///   the interaction's reach held at their start velocities; nothing from those rows reaches
+///   the chain within the step but the numerical precursor (at depth 3, 1e-13 mlp and 5e-7
+///   sph of the free velocities), and the engine stays at S_0 (docs/first_bodies.md);
 /// - finalize(R): restore S_0 and advance the real nonlinear body with the forces
 ///   R_i / h on the chain (kept as is when every R_i = 0). The chain's end velocities
 ///   reported are u = (d / h - (1 - theta) v_b) / theta with the real displacements d.
