@@ -105,9 +105,11 @@ namespace tribo::coupling
                       "within the interaction's reach carried at their start velocities, instead of on the "
                       "whole body (>= 0; 0: the whole body). The real advance with the solved impulses is "
                       "always the whole body's, so the books are unchanged; a strip too thin shows as a "
-                      "larger linearisation miss. At 3 the prediction is the whole body's to 1e-5 and the "
-                      "paper-size mlp body costs 0.62 times as much per step (docs/first_bodies.md, "
-                      "\"Trial advances on a strip\"). May change on --resume.");
+                      "larger linearisation miss. At 3 the prediction is the whole body's to 1e-5 and a "
+                      "paper-size step costs 0.53 (sph) to 0.65 (mlp) times as much; in sustained shear on "
+                      "the default case one mlp run's worst overlap grew to 0.2 r_min, which is not yet "
+                      "understood (docs/first_bodies.md, \"Trial advances on a strip\"). May change on "
+                      "--resume.");
     prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
                       "Degree p of the fem upper body's Q_p elements.");
     prm.declare_entry("Upper body modes", "20", Integer(0),
