@@ -106,10 +106,10 @@ namespace tribo::coupling
                       "whole body (>= 0; 0: the whole body). The real advance with the solved impulses is "
                       "always the whole body's, so the books are unchanged; a strip too thin shows as a "
                       "larger linearisation miss. At 3 the prediction is the whole body's to 1e-5 and a "
-                      "paper-size step costs 0.53 (sph) to 0.65 (mlp) times as much; opt-in until a second "
-                      "paired run on the default case says whether one run's lower friction (2.4 errors) "
-                      "is chance (docs/first_bodies.md, \"Trial advances on a strip\"). May change on "
-                      "--resume.");
+                      "paper-size step costs 0.53 (sph) to 0.65 (mlp) times as much, but in sustained shear "
+                      "on the default case two mlp runs with it gave a lower friction and a creeping "
+                      "overlap that the whole body's runs do not: not for results until that is understood "
+                      "(docs/first_bodies.md, \"Trial advances on a strip\"). May change on --resume.");
     prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
                       "Degree p of the fem upper body's Q_p elements.");
     prm.declare_entry("Upper body modes", "20", Integer(0),
