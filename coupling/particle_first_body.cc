@@ -60,7 +60,10 @@ namespace tribo::coupling
         engine_free = false;
         return d;
       }
-    if (!engine_at_start)
+    // S_0 is kept only when the whole body leaves it (a strip trial never does).
+    if (engine_at_start)
+      start_state = snapshot();
+    else
       restore(start_state);
     substeps        = advance(h, load, force);
     engine_at_start = false;
@@ -138,7 +141,6 @@ namespace tribo::coupling
     for (std::size_t q = 0; q < top.size(); ++q)
       top_start_y[q] = position(top[q]).y();
     dissipation_at_start = total_dissipation();
-    start_state          = snapshot();
     engine_at_start      = true;
     step_h               = h;
     step_load            = top_load(h);

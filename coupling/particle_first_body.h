@@ -183,7 +183,7 @@ namespace tribo::coupling
     std::vector<double>    top_start_y;        ///< top-row y at the start of the step, m
     Eigen::VectorXd        free_displacement;  ///< d_free, m
     Eigen::MatrixXd        G;
-    std::string            start_state;        ///< S_0 (save_engine())
+    std::string            start_state;        ///< S_0 (save_engine()), taken before the whole body first leaves it
     bool                   in_step = false;    ///< between predict() and finalize()
     bool                   engine_free = false; ///< the engine holds the free end state
     bool                   engine_at_start = false; ///< the engine holds S_0 (trials on its strip)
