@@ -98,18 +98,17 @@ namespace tribo::coupling
                       "2 / omega_max of the stiffest bond (in (0, 0.5]): smaller is more accurate and "
                       "slower. On the 120-disc cell at the fem body's step the energy books close to "
                       "0.03 % at 0.05 and to 0.17 % at 0.2, which is 3.5 times faster (docs/first_bodies.md).");
-    prm.declare_entry("Upper body prediction depth", "0", Double(),
+    prm.declare_entry("Upper body prediction depth", "3", Double(),
                       "sph and mlp upper bodies: the trial advances of each contact step (the chain's free "
                       "motion the contact solve predicts, and the columns of its compliance) run on the "
                       "bottom rows within this many wave reaches c_p h of the chain, the rows above them "
                       "within the interaction's reach carried at their start velocities, instead of on the "
-                      "whole body (>= 0; 0: the whole body). The real advance with the solved impulses is "
-                      "always the whole body's, so the books are unchanged; a strip too thin shows as a "
-                      "larger linearisation miss. At 3 the prediction is the whole body's to 1e-5 and a "
-                      "paper-size step costs 0.53 (sph) to 0.65 (mlp) times as much, but in sustained shear "
-                      "on the default case two mlp runs with it gave a lower friction and a creeping "
-                      "overlap that the whole body's runs do not: not for results until that is understood "
-                      "(docs/first_bodies.md, \"Trial advances on a strip\"). May change on --resume.");
+                      "whole body (>= 0; 0: the whole body, also used when the strip would reach the top). "
+                      "The real advance with the solved impulses is always the whole body's, so the books "
+                      "are unchanged; a strip too thin shows as a larger linearisation miss. At 3 the "
+                      "prediction is the whole body's to 1e-5 (unit tests; 1e-12 at every trial of a "
+                      "sheared default-case mlp run) and a paper-size step costs 0.53 (sph) to 0.65 (mlp) "
+                      "times as much (docs/first_bodies.md, \"Trial advances on a strip\"). May change on --resume.");
     prm.declare_entry("Upper body element degree", "1", Integer(1, 4),
                       "Degree p of the fem upper body's Q_p elements.");
     prm.declare_entry("Upper body modes", "20", Integer(0),

@@ -75,7 +75,8 @@ namespace tribo::coupling
     double       verlet_fraction = 0.05;
     /// Depth of the strip of bottom rows on which a particle body's trial advances of a step
     /// (the free prediction, the compliance's columns) run, in wave reaches c_p h (sph, mlp);
-    /// 0: the whole body (ParticleFirstBody::advance_strip()).
+    /// 0: the whole body (ParticleFirstBody::advance_strip()). The case entry's default is 3;
+    /// this struct's is 0, so that a body built in code is the whole-body reference.
     double       prediction_depth = 0;
     /// The case subsection the body's entries were read from: messages name them
     /// through it.
