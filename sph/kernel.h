@@ -33,6 +33,10 @@ namespace tribo::sph
     static double derivative(double r, double h);
     /// grad_i W for separation @p rij = x_i - x_j, 1/m^(dim+1).
     static Tensor<1, dim> gradient(const Tensor<1, dim> &rij, double h);
+    /// The same from |rij|^2 (@p r2, m^2) and 1/h (@p inv_h, 1/m), for the force loop:
+    /// grad_i W = (dW/dr / r) rij with dW/dr / r = sigma_d / h^2 (-3 + 9/4 q) for q < 1
+    /// (no division) and -3/4 sigma_d (2 - q)^2 / (h r) for 1 <= q < 2.
+    static Tensor<1, dim> gradient(const Tensor<1, dim> &rij, double r2, double inv_h);
     /// Support radius 2h, m.
     static double support(double h) { return 2 * h; }
   };
@@ -75,9 +79,25 @@ namespace tribo::sph
   template <int dim>
   inline Tensor<1, dim> CubicSplineKernel<dim>::gradient(const Tensor<1, dim> &rij, double h)
   {
-    const double r = rij.norm();
-    if (r <= 0 || r >= 2 * h)
+    return gradient(rij, rij.norm_square(), 1 / h);
+  }
+
+  template <int dim>
+  inline Tensor<1, dim> CubicSplineKernel<dim>::gradient(const Tensor<1, dim> &rij, double r2, double inv_h)
+  {
+    const double r = std::sqrt(r2);
+    const double q = r * inv_h;
+    if (r <= 0 || q >= 2)
       return Tensor<1, dim>();
-    return (derivative(r, h) / r) * rij;
+    const double inv_h2 = inv_h * inv_h;
+    double       s      = inv_h2 * inv_h2; // sigma_d / h^2
+    if constexpr (dim == 2)
+      s *= 10.0 / (7.0 * M_PI);
+    else
+      s *= inv_h / M_PI;
+    if (q < 1)
+      return (s * (-3 + 2.25 * q)) * rij;
+    const double t = 2 - q;
+    return (-0.75 * s * t * t / q) * rij;
   }
 } // namespace tribo::sph

@@ -96,7 +96,9 @@ namespace tribo::sph
     update_neighbours(s, std::max(2 * h_max, prm.boundary.range()));
 
     // Per-particle pressure, longitudinal sound speed and sigma/rho^2.
-    std::vector<double>                  c(n);
+    // Per-particle pressure, longitudinal sound speed, sigma/rho^2, volume m/rho and 1/h:
+    // loaded in the pair loop rather than recomputed per pair.
+    std::vector<double>                  c(n), volume(n), inv_h(n);
     std::vector<SymmetricTensor<2, dim>> A(n);
     parallel_for(n, [&](unsigned int i) {
       const Material &m  = mats[s.material[i]];
@@ -104,6 +106,8 @@ namespace tribo::sph
       k.pressure[i]      = ps.pressure;
       c[i] = std::sqrt(ps.sound_speed * ps.sound_speed + 4 * m.shear_modulus / (3 * s.rho[i]));
       A[i] = (s.S[i] - ps.pressure * dealii::unit_symmetric_tensor<dim>()) / (s.rho[i] * s.rho[i]);
+      volume[i] = s.mass[i] / s.rho[i];
+      inv_h[i]  = 1 / s.h[i];
     });
 
     const BoundaryForce &bf        = prm.boundary;
@@ -132,7 +136,8 @@ namespace tribo::sph
           const double hij = 0.5 * (s.h[i] + s.h[j]);
           if (r2 >= 4 * hij * hij)
             continue;
-          const Tensor<1, dim> g  = CubicSplineKernel<dim>::gradient(r, hij);
+          const double         inv_hij = s.h[i] == s.h[j] ? inv_h[i] : 1 / hij;
+          const Tensor<1, dim> g       = CubicSplineKernel<dim>::gradient(r, r2, inv_hij);
           const Tensor<1, dim> dv = s.v[i] - s.v[j];
           const double         mj = s.mass[j];
           const double         dvg = dv * g;
@@ -141,17 +146,26 @@ namespace tribo::sph
           const double vr = dv * r;
           if (vr < 0)
             {
-              const double mu = hij * vr / (r2 + eps * hij * hij);
-              Pi = (-alpha * 0.5 * (c[i] + c[j]) * mu + beta * mu * mu) /
-                   (0.5 * (s.rho[i] + s.rho[j]));
-              max_mu = std::max(max_mu, -mu);
+              // mu = h vr / D and Pi = (-alpha c mu + beta mu^2) / rho, one division.
+              const double D   = r2 + eps * hij * hij;
+              const double rho = 0.5 * (s.rho[i] + s.rho[j]);
+              const double inv = 1 / (D * rho);
+              const double mu  = hij * vr * rho * inv;
+              Pi               = (-alpha * 0.5 * (c[i] + c[j]) * mu + beta * mu * mu) * D * inv;
+              max_mu           = std::max(max_mu, -mu);
             }
-          const SymmetricTensor<2, dim> pair = A[i] + A[j];
-          acc += mj * (pair * g - Pi * g);
-          de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);
+          Tensor<1, dim> Aig, pair_g; // A_i g and (A_i + A_j) g
+          for (unsigned int a = 0; a < dim; ++a)
+            for (unsigned int b = 0; b < dim; ++b)
+              {
+                Aig[a] += A[i][a][b] * g[b];
+                pair_g[a] += (A[i][a][b] + A[j][a][b]) * g[b];
+              }
+          acc += mj * (pair_g - Pi * g);
+          de += mj * (-(dv * Aig) + 0.5 * Pi * dvg);
           heating += mj * 0.5 * Pi * dvg;
-          L -= (mj / s.rho[j]) * dealii::outer_product(dv, g);
-          M -= (mj / s.rho[j]) * dealii::outer_product(r, g);
+          L -= volume[j] * dealii::outer_product(dv, g);
+          M -= volume[j] * dealii::outer_product(r, g);
         }
       if (prm.corrected_gradient)
         {
