@@ -91,6 +91,24 @@ TEST(SphKernel, GradientIsMinusDerivativeAlongSeparationAndSupportIs2h)
   EXPECT_NEAR(CubicSplineKernel<3>::value(1.999999 * h, h), 0, 1e-15);
 }
 
+TEST(SphKernel, PlaneGradientFromSquaredDistanceAndInverseLengthIsTheDerivative)
+{
+  // The force loop's form, gradient(r, r^2, 1/h), in the plane, on both sides of q = 1.
+  const double h = 0.7;
+  for (double q : {0.2, 0.8, 0.999, 1.0, 1.3, 1.9})
+    {
+      const Tensor<1, 2> r  = (q * h / std::sqrt(5.0)) * vec<2>(2, -1);
+      const Tensor<1, 2> g  = CubicSplineKernel<2>::gradient(r, r.norm_square(), 1 / h);
+      const double       d  = 1e-6 * h;
+      const double       fd = (CubicSplineKernel<2>::value(q * h + d, h) -
+                         CubicSplineKernel<2>::value(q * h - d, h)) / (2 * d);
+      EXPECT_NEAR((g - (fd / r.norm()) * r).norm() / std::abs(fd), 0, 1e-6) << "q = " << q;
+      EXPECT_NEAR((g - CubicSplineKernel<2>::gradient(r, h)).norm() / g.norm(), 0, 1e-15);
+    }
+  EXPECT_EQ(CubicSplineKernel<2>::gradient(vec<2>(0, 2 * h), 4 * h * h, 1 / h).norm(), 0);
+  EXPECT_EQ(CubicSplineKernel<2>::gradient(vec<2>(0, 0), 0, 1 / h).norm(), 0);
+}
+
 // ---------------------------------------------------------------- EOS
 
 TEST(SphEos, TillotsonReferenceStateAndTables)
