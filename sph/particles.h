@@ -81,13 +81,8 @@ namespace tribo::sph
     Tensor<1, dim> separation(const Tensor<1, dim> &xi, const Tensor<1, dim> &xj) const
     {
       Tensor<1, dim> r = xi - xj;
-      if (period > 0) // positions within half a period of [0, L): |r_x| < 3/2 L
-        {
-          if (r[0] > 0.5 * period)
-            r[0] -= period;
-          else if (r[0] < -0.5 * period)
-            r[0] += period;
-        }
+      if (period > 0 && std::abs(r[0]) > 0.5 * period) // the division only across the period
+        r[0] -= period * std::nearbyint(r[0] / period);
       return r;
     }
 
