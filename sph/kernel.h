@@ -90,11 +90,10 @@ namespace tribo::sph
     if (r <= 0 || q >= 2)
       return Tensor<1, dim>();
     const double inv_h2 = inv_h * inv_h;
-    double       s      = inv_h2 * inv_h2; // sigma_d / h^2
-    if constexpr (dim == 2)
-      s *= 10.0 / (7.0 * M_PI);
-    else
-      s *= inv_h / M_PI;
+    double       s      = inv_h2 * inv_h2; // h^-4
+    if constexpr (dim == 3)
+      s *= inv_h;
+    s *= normalisation(1.0); // sigma_d / h^2
     if (q < 1)
       return (s * (-3 + 2.25 * q)) * rij;
     const double t = 2 - q;

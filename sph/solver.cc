@@ -95,7 +95,6 @@ namespace tribo::sph
       h_max = std::max(h_max, s.h[i]);
     update_neighbours(s, std::max(2 * h_max, prm.boundary.range()));
 
-    // Per-particle pressure, longitudinal sound speed and sigma/rho^2.
     // Per-particle pressure, longitudinal sound speed, sigma/rho^2, volume m/rho and 1/h:
     // loaded in the pair loop rather than recomputed per pair.
     std::vector<double>                  c(n), volume(n), inv_h(n);
@@ -154,15 +153,9 @@ namespace tribo::sph
               Pi               = (-alpha * 0.5 * (c[i] + c[j]) * mu + beta * mu * mu) * D * inv;
               max_mu           = std::max(max_mu, -mu);
             }
-          Tensor<1, dim> Aig, pair_g; // A_i g and (A_i + A_j) g
-          for (unsigned int a = 0; a < dim; ++a)
-            for (unsigned int b = 0; b < dim; ++b)
-              {
-                Aig[a] += A[i][a][b] * g[b];
-                pair_g[a] += (A[i][a][b] + A[j][a][b]) * g[b];
-              }
-          acc += mj * (pair_g - Pi * g);
-          de += mj * (-(dv * Aig) + 0.5 * Pi * dvg);
+          const SymmetricTensor<2, dim> pair = A[i] + A[j];
+          acc += mj * (pair * g - Pi * g);
+          de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);
           heating += mj * 0.5 * Pi * dvg;
           L -= volume[j] * dealii::outer_product(dv, g);
           M -= volume[j] * dealii::outer_product(r, g);
