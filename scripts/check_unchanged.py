@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Proof that a refactoring changed no result: a short run of every scene and first-body
 model, from the shipped cases, gives a statistics.csv identical, byte for byte, to the
 one stored in tests/unchanged/ (issue 24: "behaviour unchanged").
