@@ -2,6 +2,7 @@
 """Two shear runs' layer profiles compared layer by layer, with their standard errors.
 
     /usr/bin/python3 scripts/compare_profiles.py RUN_A RUN_B [--labels A,B] [--plot FILE.png]
+        [--control RUN_C RUN_D]
 
 Reads RUN_A/profiles.csv and RUN_B/profiles.csv (docs/outputs.md: the means over each run's
 averaging window, with batch-means standard errors) and, for vx, solid_fraction, sigma_xy
@@ -10,8 +11,17 @@ and granular_temperature, the difference of each layer in units of the combined 
 printed as a table: the largest |z|, how many layers lie beyond 2, and the mean z (a
 systematic shift shows as a mean far from zero). Layers are matched by index, and both
 runs must have the same number of layers across the gap (y / h is the coordinate). With
---plot, an overlay of the four columns against y / h with error bars. Exit code 2 on a
-missing or unreadable file or mismatched layers.
+--plot, an overlay of the four columns against y / h with error bars.
+
+Batch-means errors measure the scatter within one run. Two realisations of one setting
+(another seed, another rounding) can differ by more: a run's window may sit in one regime
+of the layer for longer than its batches (docs/first_bodies.md, docs/validation.md). With
+--control RUN_C RUN_D, such a pair, each column's inflation
+    k = max(1, sqrt(mean over the layers of z_CD^2))
+is measured (k = 1 when the batch errors cover the realisations' spread, since z is then
+about N(0, 1) in each layer), and the comparison of A and B is also given in units of
+k times the combined error. Layers are correlated, so k from one pair is a rough figure.
+Exit code 2 on a missing or unreadable file or mismatched layers.
 """
 import argparse
 import os
@@ -59,6 +69,8 @@ def main():
     parser.add_argument("runs", nargs=2, metavar="RUN")
     parser.add_argument("--labels", default=None, help="two comma-separated labels (default: the directories)")
     parser.add_argument("--plot", default=None, help="write an overlay figure here")
+    parser.add_argument("--control", nargs=2, default=None, metavar="RUN",
+                        help="two realisations of one setting: the batch errors' inflation k per column")
     args = parser.parse_args()
     labels = args.labels.split(",") if args.labels else list(args.runs)
     if len(labels) != 2:
@@ -67,11 +79,29 @@ def main():
     if len(a) != len(b):
         fail(f"{path_b}: {len(b)} layers, {path_a} has {len(a)}: the runs must have the same layers")
     rows = compare(a, b)
+    inflation = None
+    if args.control:
+        (path_c, c_run), (path_d, d_run) = read(args.control[0]), read(args.control[1])
+        for path, table in ((path_c, c_run), (path_d, d_run)):
+            if len(table) != len(a):
+                fail(f"{path}: {len(table)} layers, {path_a} has {len(a)}: the runs must have the same layers")
+        inflation = {c: max(1.0, float(np.sqrt(np.mean(z ** 2)))) if z.size else 1.0
+                     for c, (_, _, _, z) in compare(c_run, d_run).items()}
+        print(f"control: {args.control[1]} against {args.control[0]}; "
+              "k = max(1, root mean square of their z over the layers)")
     print(f"{labels[1]} against {labels[0]}, {len(a)} layers; z = difference / combined standard error")
-    print("| column | max abs z | layers beyond 2 | mean z |")
-    print("|---|---|---|---|")
-    for c, (zmax, beyond, zmean, _) in rows.items():
-        print(f"| {c} | {zmax:.2f} | {beyond} | {zmean:+.2f} |")
+    if inflation is None:
+        print("| column | max abs z | layers beyond 2 | mean z |")
+        print("|---|---|---|---|")
+        for c, (zmax, beyond, zmean, _) in rows.items():
+            print(f"| {c} | {zmax:.2f} | {beyond} | {zmean:+.2f} |")
+    else:
+        print("| column | max abs z | layers beyond 2 | mean z | k | max abs z / k | layers beyond 2 k | mean z / k |")
+        print("|---|---|---|---|---|---|---|---|")
+        for c, (zmax, beyond, zmean, z) in rows.items():
+            k = inflation[c]
+            print(f"| {c} | {zmax:.2f} | {beyond} | {zmean:+.2f} | {k:.2f} | {zmax / k:.2f} | "
+                  f"{int((np.abs(z) > 2 * k).sum())} | {zmean / k:+.2f} |")
     if args.plot:
         sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
         from plotting import plt, save  # scripts/plotting.py

@@ -51,6 +51,34 @@ class CompareProfiles(TempDirTestCase):
         image = read_png(self, png)
         self.assertGreater(image.shape[1], image.shape[0])  # four panels side by side
 
+    def test_a_control_pair_measures_how_far_the_batch_errors_understate_realisations(self):
+        a, b, c, d = (os.path.join(self.tmp, n) for n in "abcd")
+        write_profiles(a, 5)
+        write_profiles(b, 5, {"vx": {2: 0.3, 4: -0.1}})  # z = 2.121 and -0.707, as above
+        # The control pair: vx differs by +-2 combined errors in every layer (k = 2), the
+        # solid fraction by 0.5 of one in layer 0 (root mean square 0.22: k = 1, not below).
+        e = 0.1 * np.sqrt(2)
+        write_profiles(c, 5)
+        write_profiles(d, 5, {"vx": {i: 2 * e * (-1) ** i for i in range(5)}, "solid_fraction": {0: 0.5 * e}})
+        r = compare_profiles(a, b, "--control", c, d)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = {line.split("|")[1].strip(): [cell.strip() for cell in line.split("|")[2:9]]
+                for line in r.stdout.splitlines() if line.startswith("| ") and not line.startswith("| column")}
+        zmean = (2.1213 - 0.7071) / 5
+        self.assertEqual(rows["vx"], ["2.12", "1", "%+.2f" % zmean, "2.00", "1.06", "0", "%+.2f" % (zmean / 2)])
+        self.assertEqual(rows["solid_fraction"], ["0.00", "0", "+0.00", "1.00", "0.00", "0", "+0.00"])
+        self.assertIn("control: " + d + " against " + c, r.stdout)
+
+    def test_a_control_with_other_layers_is_refused(self):
+        a, b, c, d = (os.path.join(self.tmp, n) for n in "abcd")
+        for run in (a, b, c):
+            write_profiles(run, 5)
+        write_profiles(d, 6)
+        r = compare_profiles(a, b, "--control", c, d)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(os.path.join(d, "profiles.csv") + ": 6 layers, " + os.path.join(a, "profiles.csv") +
+                      " has 5: the runs must have the same layers", r.stderr)
+
     def test_mismatched_layers_are_refused(self):
         a, b = os.path.join(self.tmp, "a"), os.path.join(self.tmp, "b")
         write_profiles(a, 5)
