@@ -27,6 +27,16 @@ namespace tribo::app
       return usage.ru_maxrss / 1024.0;
     }
 
+    /// What SolveReport::iterations counts for @p method, as it follows a number.
+    const char *iteration_unit(dem::SolverParameters::Method method)
+    {
+      using Method = dem::SolverParameters::Method;
+      return method == Method::mprgp  ? " NLGS sweeps and MPRGP products"
+             : method == Method::apgd ? " NLGS sweeps and APGD products"
+             : method == Method::apgs ? " NLGS sweeps, APGS sweeps and products"
+                                      : " NLGS sweeps";
+    }
+
     /// Where the steps' wall time goes, over the steps of this process (since the start
     /// or the last resumption: not checkpointed), for summary.json "timing".
     struct StepTiming
@@ -172,10 +182,28 @@ namespace tribo::app
         timing.add(r);
         if (!r.solver.converged && ++record.non_converged <= 10)
           {
+            // Which solve stopped short: NLGS (the method, the frictional steps of every
+            // method, the active set's fallback) with its own norm, or a global method at
+            // its law residual.
+            const auto method = prm.solver.method;
+            const bool by_nlgs =
+              method == dem::SolverParameters::Method::nlgs || prm.law.friction > 0 || r.solver.fell_back;
             std::ostringstream os;
-            os << "warning: step " << step << " (t = " << time() << " s): NLGS did not converge in "
-               << r.solver.iterations << " sweeps, residual " << r.solver.residual
-               << (record.non_converged == 10 ? " (further warnings only counted)" : "");
+            os << "warning: step " << step << " (t = " << time() << " s): ";
+            if (by_nlgs)
+              os << "NLGS did not converge in " << r.solver.iterations << " sweeps, residual " << r.solver.residual;
+            else
+              {
+                os << "Solver/Method = " << dem::method_name(method) << " stopped at law residual "
+                   << r.solver.law_residual << " (Solver/Residual target = " << prm.solver.residual_target
+                   << ") after ";
+                if (r.solver.factorizations > 0)
+                  os << r.solver.factorizations << " factorisations"
+                     << (r.solver.iterations > 0 ? " and " : "");
+                if (r.solver.iterations > 0 || r.solver.factorizations == 0)
+                  os << r.solver.iterations << iteration_unit(method);
+              }
+            os << (record.non_converged == 10 ? " (further warnings only counted)" : "");
             warn(os.str());
           }
         last = Row();
@@ -304,10 +332,7 @@ namespace tribo::app
 
         std::ostringstream os;
         os << steps_run << " steps in " << end.wall_time << " s, " << per_step(record.total_iterations)
-           << (method == dem::SolverParameters::Method::mprgp  ? " NLGS sweeps and MPRGP products"
-               : method == dem::SolverParameters::Method::apgd ? " NLGS sweeps and APGD products"
-               : method == dem::SolverParameters::Method::apgs ? " NLGS sweeps, APGS sweeps and products"
-                                                               : " NLGS sweeps")
+           << iteration_unit(method)
            << " per step, " << record.non_converged << " steps not converged, law residual mean "
            << per_step(record.sum_law_residual) << " max " << record.max_law_residual << ", worst overlap "
            << record.worst_overlap << " m";

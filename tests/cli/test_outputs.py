@@ -898,6 +898,57 @@ class SparseStatistics(TempDirTestCase):
                                    rtol=1e-12)
 
 
+class SolveStoppedShort(TempDirTestCase):
+    """A step whose contact solve stops short is a warning naming the solve that stopped:
+    a global method by its law residual and target, NLGS by its own norm."""
+
+    WARNING = r"^warning: step (\d+) \(t = (\S+) s\): "
+
+    def run_short(self, solver):
+        sections = shear_sections("60", "4e-7", "1e-6", "1e-7", "false", Solver=solver)
+        sections["Output"]["Field interval"] = "0"
+        write_prm(os.path.join(self.tmp, "case.prm"), sections)
+        r = run(["run", "case.prm", "--output", "out", "--quiet"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        s = read_json(os.path.join(self.tmp, "out", "summary.json"))
+        _, st = read_csv(os.path.join(self.tmp, "out", "statistics.csv"))
+        with open(os.path.join(self.tmp, "out", "log.txt")) as f:
+            warnings = [l for l in f.read().splitlines() if l.startswith("warning: step")]
+        # Steps not converged: as many as the rows say, at most ten of them as lines.
+        n = int((st["nlgs_converged"] == 0).sum())
+        self.assertGreater(n, 0, "one factorisation / one sweep cannot solve every step")
+        self.assertEqual(s["nlgs_non_converged_steps"], n)
+        self.assertEqual(len(warnings), min(n, 10))
+        if n >= 10:
+            self.assertTrue(warnings[-1].endswith(" (further warnings only counted)"), warnings[-1])
+        return warnings, st
+
+    def test_interior_point(self):
+        """One factorisation per step: the warning gives the method, its law residual (the
+        statistics row's, above the target) and the factorisations done."""
+        warnings, st = self.run_short({"Method": "interior-point", "Maximum factorizations": "1",
+                                       "Predictor sweeps": "0"})
+        for line in warnings:
+            m = re.match(self.WARNING + r"Solver/Method = interior-point stopped at law residual (\S+) "
+                         r"\(Solver/Residual target = 0\.001\) after 1 factorisations"
+                         r"( \(further warnings only counted\))?$", line)
+            self.assertTrue(m, line)
+            row = list(st["step"]).index(int(m.group(1)))
+            self.assertEqual(st["nlgs_converged"][row], 0)
+            self.assertAlmostEqual(float(m.group(3)) / st["law_residual"][row], 1, delta=1e-5)
+            self.assertGreater(float(m.group(3)), 1e-3)
+
+    def test_nlgs(self):
+        """One sweep per step: the warning is NLGS's, with its sweeps and its own norm."""
+        warnings, st = self.run_short({"Method": "nlgs", "Maximum iterations": "1", "Check interval": "1"})
+        for line in warnings:
+            m = re.match(self.WARNING + r"NLGS did not converge in 1 sweeps, residual (\S+)"
+                         r"( \(further warnings only counted\))?$", line)
+            self.assertTrue(m, line)
+            row = list(st["step"]).index(int(m.group(1)))
+            self.assertAlmostEqual(float(m.group(3)) / st["nlgs_residual"][row], 1, delta=1e-5)
+
+
 class FailedRun(TempDirTestCase):
     """A run that cannot go on: exit 1, status failed, the reason in summary and log; no plots."""
 
