@@ -35,9 +35,12 @@ def resume(end, dst, extra):
     args = [tribo, "run", os.path.join(dst, "parameters.prm"), "--resume", dst, "--quiet"]
     for s in fixed + ["Simulation/End time=%.17g" % end] + extra:
         args += ["--set", s]
-    subprocess.run(args, capture_output=True)  # a failed run is reported, not fatal
-    step0 = int(re.findall(r"resumed at step (\d+)", open(os.path.join(dst, "log.txt")).read())[-1])
-    return step0, json.load(open(os.path.join(dst, "summary.json")))
+    before = open(os.path.join(dst, "log.txt")).read().count("resumed at step")
+    run = subprocess.run(args, capture_output=True, text=True)  # a failed run is reported, not fatal
+    resumed = re.findall(r"resumed at step (\d+)", open(os.path.join(dst, "log.txt")).read())
+    if len(resumed) == before:
+        sys.exit(f"{src}: the checkpoint did not resume: {run.stderr.strip()[:300]}")
+    return int(resumed[-1]), json.load(open(os.path.join(dst, "summary.json")))
 
 
 prm = open(os.path.join(src, "parameters.prm")).read()
@@ -53,7 +56,10 @@ if m and spread:
 tmp = tempfile.mkdtemp()
 try:
     dst = os.path.join(tmp, "run")
-    step0, _ = resume(1e-12, dst, [])  # logs the checkpoint's step, runs nothing
+    # An End time at the run's first step is before its checkpoint and after any Initial
+    # state's t0: the resume logs the checkpoint's step and runs nothing.
+    first = next(csv.DictReader(open(os.path.join(src, "statistics.csv"))))
+    step0, at_checkpoint = resume(float(first["time"]), dst, [])
     print(f"checkpoint {src} at step {step0}, {steps} steps per setting")
     print("| setting | ms per step | solver ms | detection ms | iterations per step | factorisations per step "
           "| law residual mean / max | worst overlap / r_min | mu |")
@@ -68,8 +74,10 @@ try:
                   flush=True)
             continue
         t = s["timing"]
-        # summary.json's mean is over every step of the run, the checkpoint's (NLGS) included.
-        factorizations = s.get("factorizations_mean", 0) * s["steps"] / len(rows)
+        # summary.json's mean is over every step of the run, the checkpoint's included: take
+        # away the factorisations the run had made by its checkpoint.
+        factorizations = (s.get("factorizations_mean", 0) * s["steps"]
+                          - at_checkpoint.get("factorizations_mean", 0) * at_checkpoint["steps"]) / len(rows)
         lr = [float(r["law_residual"]) for r in rows]
         overlap = max(float(r["max_overlap"]) for r in rows)
         mu = np.array([float(r["mu"]) for r in rows])
