@@ -101,6 +101,17 @@ namespace tribo::dem
     return partition;
   }
 
+  Eigen::SparseMatrix<double> permuted_upper(const Eigen::SparseMatrix<double> &A, const int *order)
+  {
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P(A.rows());
+    for (int k = 0; k < A.rows(); ++k)
+      P.indices()[order[k]] = k; // Eigen's P moves row order[k] to k
+    Eigen::SparseMatrix<double> upper(A.rows(), A.cols());
+    upper.selfadjointView<Eigen::Upper>() = A.selfadjointView<Eigen::Lower>().twistedBy(P);
+    // Eigen leaves the columns' rows unsorted; a change of storage order sorts them.
+    return Eigen::SparseMatrix<double, Eigen::RowMajor>(upper);
+  }
+
   BisectedCholesky::BisectedCholesky(const Eigen::SparseMatrix<double> &A, const std::vector<int> &part)
   {
     for (Side &s : sides)
@@ -168,29 +179,32 @@ namespace tribo::dem
         }
       s.E = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, int>>(
         size, size, start[size], start.data(), index.data(), value.data());
-      s.diagonal.resize(size);
-      s.unit.resize(size);
-      for (Eigen::Index q = 0; q < size; ++q)
-        {
-          s.diagonal[q] = &s.E.coeffRef(q, q);
-          s.unit[q]     = *s.diagonal[q];
-        }
-      // CAMD with the separator as the last constraint set, then the analysis with that
-      // order as given (no postordering, which could interleave the separator).
+      // CAMD with the separator as the last constraint set; E_i is then kept permuted by
+      // that order and analysed as given (no postordering, which could interleave the
+      // separator).
       std::vector<int> member(size, 0), order(size);
       std::fill(member.begin() + s.own, member.end(), 1);
       cholmod_sparse e = Eigen::viewAsCholmod(s.E);
       e.stype          = -1;
       if (!cholmod_camd(&e, nullptr, 0, member.data(), order.data(), &s.common))
         return; // analysed[i] stays false
+      s.E = permuted_upper(s.E, order.data());
+      s.diagonal.resize(size);
+      s.unit.resize(size);
+      for (Eigen::Index k = 0; k < size; ++k)
+        {
+          s.diagonal[k] = &s.E.coeffRef(k, k);
+          s.unit[k]     = *s.diagonal[k];
+        }
       s.common.nmethods           = 1;
-      s.common.method[0].ordering = CHOLMOD_GIVEN;
+      s.common.method[0].ordering = CHOLMOD_NATURAL;
       s.common.postorder          = 0;
-      s.L = cholmod_analyze_p(&e, order.data(), nullptr, 0, &s.common);
+      e       = Eigen::viewAsCholmod(s.E);
+      e.stype = 1;
+      s.L     = cholmod_analyze(&e, &s.common);
       if (!s.L)
         return; // analysed[i] stays false
-      const int *perm = static_cast<const int *>(s.L->Perm);
-      s.permutation.assign(perm, perm + size);
+      s.permutation = order;
       s.separator_at.resize(m);
       for (long q = 0; q < m; ++q)
         {
@@ -243,10 +257,10 @@ namespace tribo::dem
     bool       ok[2];
     for_both_sides([&](int i) {
       Side &s = sides[i];
-      for (Eigen::Index q = 0; q < Eigen::Index(s.rows.size()); ++q)
-        *s.diagonal[q] = s.unit[q] + shift[s.rows[q]];
+      for (Eigen::Index k = 0; k < Eigen::Index(s.rows.size()); ++k)
+        *s.diagonal[k] = s.unit[k] + shift[s.rows[s.permutation[k]]];
       cholmod_sparse e = Eigen::viewAsCholmod(s.E);
-      e.stype          = -1;
+      e.stype          = 1;
       cholmod_factorize(&e, s.L, &s.common);
       ok[i] = s.common.status == CHOLMOD_OK && s.L->minor == s.L->n && s.L->is_ll;
       if (!ok[i])

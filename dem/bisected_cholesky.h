@@ -52,6 +52,14 @@ namespace tribo::dem
   /// every half-disc contact).
   std::vector<int> grain_bisection(const std::vector<Contact> &contacts, const BodyState &state);
 
+  /// The upper triangle of P @p A P^T (@p A symmetric, its lower triangle read), row k of
+  /// it row @p order[k] of @p A, each column's rows sorted: the matrix a fill-reducing
+  /// @p order asks CHOLMOD to factorise, handed over already permuted so that it is
+  /// factorised as given (natural ordering, stype > 0). With an ordering of its own CHOLMOD
+  /// forms that matrix by a transpose at every factorisation (6 % of the interior point's
+  /// step, docs/performance.md).
+  Eigen::SparseMatrix<double> permuted_upper(const Eigen::SparseMatrix<double> &A, const int *order);
+
   class BisectedCholesky
   {
   public:
@@ -85,9 +93,9 @@ namespace tribo::dem
     {
       std::vector<int>            rows;
       Eigen::Index                own = 0;      ///< the side's own rows (local 0 .. own - 1)
-      Eigen::SparseMatrix<double> E;            ///< E_i, both triangles
-      std::vector<double *>       diagonal;     ///< E_i's diagonal entries
-      Eigen::VectorXd             unit;         ///< A's diagonal on the local rows
+      Eigen::SparseMatrix<double> E;            ///< the upper triangle of P_i E_i P_i^T
+      std::vector<double *>       diagonal;     ///< its diagonal entries, in P_i's order
+      Eigen::VectorXd             unit;         ///< A's diagonal there
       mutable cholmod_common      common; ///< per side: the two run concurrently
       cholmod_factor             *L = nullptr;
       std::vector<int>            permutation;  ///< local row at permuted position q

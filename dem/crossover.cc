@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace tribo::dem
 {
@@ -12,12 +13,28 @@ namespace tribo::dem
   {
     if (halves.split())
       return;
-    cholesky.cholmod().print = 0; // a failed factorisation is reported by factorise()
+    cholmod_common &common = cholesky.cholmod();
+    common.print           = 0; // a failed factorisation is reported by factorise()
     cholesky.setMode(Eigen::CholmodSimplicialLLt);
+    // CHOLMOD's own analysis (AMD, or METIS if AMD fills badly; postordered) gives P.
+    cholmod_sparse lower = Eigen::viewAsCholmod(K);
+    lower.stype          = -1;
+    cholmod_factor *symbolic = cholmod_analyze(&lower, &common);
+    if (symbolic == nullptr)
+      throw std::runtime_error("CHOLMOD could not analyse the interior point's Newton matrix");
+    const int *order = static_cast<const int *>(symbolic->Perm);
+    ordering.resize(K.rows());
+    for (int k = 0; k < K.rows(); ++k)
+      ordering.indices()[order[k]] = k; // Eigen's P x puts x[order[k]] at k
+    K = permuted_upper(K, order);        // analysed in its natural order below
+    cholmod_free_factor(&symbolic, &common);
+    common.nmethods             = 1;
+    common.method[0].ordering   = CHOLMOD_NATURAL;
+    common.postorder            = 0;
     cholesky.analyzePattern(K);
     for (Eigen::Index j = 0; j < K.rows(); ++j)
       {
-        diagonal[j] = &K.coeffRef(j, j);
+        diagonal[j] = &K.coeffRef(ordering.indices()[j], ordering.indices()[j]);
         unit[j]     = *diagonal[j];
       }
   }
@@ -49,13 +66,15 @@ namespace tribo::dem
 
   Eigen::VectorXd ShiftedFactorisation::solve_sparse(const Eigen::VectorXd &v) const
   {
-    return halves.split() ? halves.solve(v) : Eigen::VectorXd(cholesky.solve(v));
+    if (halves.split())
+      return halves.solve(v);
+    return ordering.transpose() * Eigen::VectorXd(cholesky.solve(ordering * v));
   }
 
   Eigen::MatrixXd ShiftedFactorisation::solve_sparse(const Eigen::MatrixXd &V) const
   {
     if (!halves.split())
-      return cholesky.solve(V);
+      return ordering.transpose() * Eigen::MatrixXd(cholesky.solve(ordering * V));
     Eigen::MatrixXd X(V.rows(), V.cols());
     for (Eigen::Index c = 0; c < V.cols(); ++c)
       X.col(c) = halves.solve(V.col(c));

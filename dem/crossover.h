@@ -23,7 +23,9 @@ namespace tribo::dem
   /// 3800-grain benchmark, docs/performance.md); given a @p partition of its rows (from 4000
   /// contacts, with a small separator), in two halves on both cores
   /// (dem/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
-  /// each factorise() is one numeric factorisation. A wall clump touched by m
+  /// each factorise() is one numeric factorisation. Whole, K is kept as the upper triangle
+  /// of P K P^T, P the analysis' fill-reducing ordering, so that CHOLMOD factorises it as
+  /// given: with its own ordering it would transpose K at every factorisation. A wall clump touched by m
   /// contacts would make an m x m dense block: it stays out as U'U'^T, K_s = K - U'U'^T is
   /// factorised and K solved by Woodbury, K^-1 v = K_s^-1 v - Z (I + U'^T Z)^-1 U'^T K_s^-1 v
   /// with Z = K_s^-1 U', plus one step of iterative refinement against K (the update loses
@@ -44,11 +46,14 @@ namespace tribo::dem
 
   private:
     const FrictionlessProblem::Scaled &p;
+    /// K, or with one thread the upper triangle of P K P^T
     Eigen::SparseMatrix<double>        K;
-    std::vector<double *>              diagonal; ///< K's diagonal entries
+    /// P: row k of P K P^T is row order[k] of K (CHOLMOD's Perm)
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> ordering;
+    std::vector<double *>              diagonal; ///< K's diagonal entries, in K's order
     Eigen::VectorXd                    unit;     ///< A''s diagonal (1 - |U'_i|^2 with low-rank walls)
     Eigen::VectorXd                    barrier;
-    Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
+    Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Upper> cholesky;
     BisectedCholesky                   halves;
     /// K_s^-1 @p v (K_s = A' + diag(barrier)), whole or in halves.
     Eigen::VectorXd                    solve_sparse(const Eigen::VectorXd &v) const;

@@ -1,6 +1,8 @@
 // The two-way split Cholesky factorisation (dem/bisected_cholesky.h) against the whole
-// factor (the interior point on two threads: tests/unit/test_contact_solvers.cc).
+// factor (the interior point on two threads: tests/unit/test_contact_solvers.cc), and the
+// whole factor of the interior point's Newton matrix (dem/crossover.h).
 #include "dem/bisected_cholesky.h"
+#include "dem/crossover.h"
 
 #include <Eigen/SparseCholesky>
 
@@ -79,4 +81,33 @@ TEST(BisectedCholesky, SmallProblemsAndLargeSeparatorsAreNotSplit)
   EXPECT_FALSE(BisectedCholesky(periodic_strip(400, 12), {}).split());                   // no partition
   EXPECT_FALSE(BisectedCholesky(periodic_strip(300, 12), two_cuts(300, 12)).split());    // 3600 < min_rows
   EXPECT_FALSE(BisectedCholesky(periodic_strip(400, 12), two_cuts(400, 12, 10)).split()); // 10 % separator
+}
+
+TEST(ShiftedFactorisation, SolvesTheNewtonMatrixInItsOwnOrder)
+{
+  // K = A + diag(barrier) + U U^T, factorised whole in the analysis' order (P K P^T kept
+  // as given): the solution must come back in K's own order, every factorisation.
+  FrictionlessProblem::Scaled p;
+  p.A = periodic_strip(60, 7);
+  const Eigen::Index n = p.A.rows();
+  for (const int walls : {0, 2})
+    {
+      p.U = Eigen::MatrixXd::Zero(n, walls);
+      for (int c = 0; c < walls; ++c)
+        for (Eigen::Index j = c; j < n; j += 7)
+          p.U(j, c) = 0.1;
+      ShiftedFactorisation K(p);
+      const Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0).array().sin();
+      for (const double spread : {0.0, 10.0, 28.0})
+        {
+          Eigen::VectorXd barrier(n);
+          for (Eigen::Index j = 0; j < n; ++j)
+            barrier[j] = spread == 0 ? 0.0 : std::pow(10.0, -8 + spread * double((j * 7919) % 97) / 96);
+          ASSERT_TRUE(K.factorise(barrier)) << spread;
+          const Eigen::VectorXd x  = K.solve(v);
+          const Eigen::VectorXd Kx = p.product(x) + barrier.cwiseProduct(x);
+          EXPECT_LT((Kx - v).norm(), 1e-12 * v.norm()) << walls << " walls, spread " << spread;
+        }
+      EXPECT_EQ(K.factorizations, 3U);
+    }
 }
