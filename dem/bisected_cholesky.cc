@@ -28,69 +28,88 @@ namespace tribo::dem
     }
   } // namespace
 
+  namespace
+  {
+    /// The graph of the bodies that couple contacts in A' (bodies with a free dof and at
+    /// most LowRankBodies::contact_limit contacts), in METIS's compressed form: an edge per
+    /// pair of bodies in contact (repeats, e.g. a clump touching a grain twice, as edge
+    /// weights), a vertex weighted by its contacts. Empty (no vertices) with a contact on a
+    /// boundary body or fewer than two such bodies.
+    struct GrainGraph
+    {
+      std::vector<idx_t> vertex; ///< per body: its vertex, or -1
+      std::vector<idx_t> start{0}, adjacent, multiplicity, weight;
+      idx_t              vertices = 0;
+
+      GrainGraph(const std::vector<Contact> &contacts, const BodyState &state)
+      {
+        const std::size_t nb = state.inverse_mass.size();
+        std::vector<int>  count(nb, 0);
+        for (const Contact &c : contacts)
+          {
+            if (c.on_boundary())
+              return;
+            ++count[c.body[0]];
+            ++count[c.body[1]];
+          }
+        const unsigned int limit = LowRankBodies{}.contact_limit;
+        vertex.assign(nb, -1);
+        for (std::size_t b = 0; b < nb; ++b)
+          {
+            const auto &im = state.inverse_mass[b];
+            if (count[b] > 0 && count[b] <= int(limit) && (im[0] > 0 || im[1] > 0 || im[2] > 0))
+              {
+                vertex[b] = idx_t(weight.size());
+                weight.push_back(count[b]);
+              }
+          }
+        if (weight.size() < 2)
+          return;
+        std::vector<std::vector<idx_t>> neighbours(weight.size());
+        for (const Contact &c : contacts)
+          {
+            const idx_t a = vertex[c.body[0]], b = vertex[c.body[1]];
+            if (a >= 0 && b >= 0 && a != b)
+              {
+                neighbours[a].push_back(b);
+                neighbours[b].push_back(a);
+              }
+          }
+        for (auto &list : neighbours)
+          {
+            std::sort(list.begin(), list.end());
+            for (std::size_t k = 0; k < list.size(); ++k)
+              if (k > 0 && list[k] == list[k - 1])
+                ++multiplicity.back();
+              else
+                {
+                  adjacent.push_back(list[k]);
+                  multiplicity.push_back(1);
+                }
+            start.push_back(idx_t(adjacent.size()));
+          }
+        vertices = idx_t(weight.size());
+      }
+    };
+  } // namespace
+
   std::vector<int> grain_bisection(const std::vector<Contact> &contacts, const BodyState &state)
   {
-    const std::size_t nb = state.inverse_mass.size();
-    std::vector<int>  count(nb, 0);
-    for (const Contact &c : contacts)
-      {
-        if (c.on_boundary())
-          return {};
-        ++count[c.body[0]];
-        ++count[c.body[1]];
-      }
-    // The bodies that couple contacts in A', numbered 0 .. vertices - 1.
-    const unsigned int limit = LowRankBodies{}.contact_limit;
-    std::vector<idx_t> vertex(nb, -1), weight;
-    for (std::size_t b = 0; b < nb; ++b)
-      {
-        const auto &im = state.inverse_mass[b];
-        if (count[b] > 0 && count[b] <= int(limit) && (im[0] > 0 || im[1] > 0 || im[2] > 0))
-          {
-            vertex[b] = idx_t(weight.size());
-            weight.push_back(count[b]);
-          }
-      }
-    idx_t vertices = idx_t(weight.size());
-    if (vertices < 2)
+    GrainGraph g(contacts, state);
+    if (g.vertices < 2)
       return {};
-    // Adjacency without repeats (a clump may touch a grain twice): the repeats as weights.
-    std::vector<std::vector<std::pair<idx_t, idx_t>>> neighbours(vertices);
-    for (const Contact &c : contacts)
-      {
-        const idx_t a = vertex[c.body[0]], b = vertex[c.body[1]];
-        if (a >= 0 && b >= 0 && a != b)
-          {
-            neighbours[a].push_back({b, 1});
-            neighbours[b].push_back({a, 1});
-          }
-      }
-    std::vector<idx_t> start{0}, adjacent, multiplicity;
-    for (auto &list : neighbours)
-      {
-        std::sort(list.begin(), list.end());
-        for (std::size_t k = 0; k < list.size(); ++k)
-          if (k > 0 && list[k].first == list[k - 1].first)
-            ++multiplicity.back();
-          else
-            {
-              adjacent.push_back(list[k].first);
-              multiplicity.push_back(1);
-            }
-        start.push_back(idx_t(adjacent.size()));
-      }
     idx_t options[METIS_NOPTIONS];
     METIS_SetDefaultOptions(options);
     idx_t              constraints = 1, parts = 2, cut = 0;
-    std::vector<idx_t> side(vertices);
-    if (METIS_PartGraphRecursive(&vertices, &constraints, start.data(), adjacent.data(), weight.data(),
-                                 nullptr, multiplicity.data(), &parts, nullptr, nullptr, options, &cut,
+    std::vector<idx_t> side(g.vertices);
+    if (METIS_PartGraphRecursive(&g.vertices, &constraints, g.start.data(), g.adjacent.data(), g.weight.data(),
+                                 nullptr, g.multiplicity.data(), &parts, nullptr, nullptr, options, &cut,
                                  side.data()) != METIS_OK)
       return {};
     std::vector<int> partition(contacts.size());
     for (std::size_t i = 0; i < contacts.size(); ++i)
       {
-        const idx_t a = vertex[contacts[i].body[0]], b = vertex[contacts[i].body[1]];
+        const idx_t a = g.vertex[contacts[i].body[0]], b = g.vertex[contacts[i].body[1]];
         if (a >= 0 && b >= 0)
           partition[i] = side[a] == side[b] ? int(side[a]) : 2;
         else if (a >= 0 || b >= 0)
@@ -99,6 +118,35 @@ namespace tribo::dem
           partition[i] = 0; // couples nothing in A' (both bodies walls or imposed)
       }
     return partition;
+  }
+
+  std::vector<int> grain_dissection(const std::vector<Contact> &contacts, const BodyState &state)
+  {
+    GrainGraph g(contacts, state);
+    if (g.vertices < 2 * grains_per_part)
+      return {};
+    int levels = 1; // 2^levels parts of at least grains_per_part grains
+    while ((g.vertices >> (levels + 1)) >= grains_per_part)
+      ++levels;
+    idx_t options[METIS_NOPTIONS];
+    METIS_SetDefaultOptions(options);
+    idx_t              constraints = 1, parts = idx_t(1) << levels, cut = 0;
+    std::vector<idx_t> part(g.vertices);
+    if (METIS_PartGraphRecursive(&g.vertices, &constraints, g.start.data(), g.adjacent.data(), g.weight.data(),
+                                 nullptr, g.multiplicity.data(), &parts, nullptr, nullptr, options, &cut,
+                                 part.data()) != METIS_OK)
+      return {};
+    // METIS numbers the parts of a recursive bisection as its tree: parts p and q were
+    // split at the level of the highest bit of p xor q.
+    std::vector<int> level(contacts.size(), 0);
+    for (std::size_t i = 0; i < contacts.size(); ++i)
+      {
+        const idx_t a = g.vertex[contacts[i].body[0]], b = g.vertex[contacts[i].body[1]];
+        if (a >= 0 && b >= 0)
+          for (auto x = unsigned(part[a] ^ part[b]); x > 0; x >>= 1)
+            ++level[i];
+      }
+    return level;
   }
 
   Eigen::SparseMatrix<double> permuted_upper(const Eigen::SparseMatrix<double> &A, const int *order)

@@ -7,7 +7,8 @@
 namespace tribo::dem
 {
   ShiftedFactorisation::ShiftedFactorisation(const FrictionlessProblem::Scaled &problem,
-                                             const std::vector<int> &partition)
+                                             const std::vector<int> &partition,
+                                             const std::vector<int> &levels)
     : p(problem), K(problem.A), diagonal(problem.A.rows()), unit(problem.A.rows()),
       barrier(Eigen::VectorXd::Zero(problem.A.rows())), halves(problem.A, partition)
   {
@@ -16,10 +17,20 @@ namespace tribo::dem
     cholmod_common &common = cholesky.cholmod();
     common.print           = 0; // a failed factorisation is reported by factorise()
     cholesky.setMode(Eigen::CholmodSimplicialLLt);
-    // CHOLMOD's own analysis (AMD, or METIS if AMD fills badly; postordered) gives P.
+    // P: CAMD's order of the dissection's levels, or CHOLMOD's own (AMD, or METIS if AMD
+    // fills badly); postordered by the analysis.
     cholmod_sparse lower = Eigen::viewAsCholmod(K);
     lower.stype          = -1;
-    cholmod_factor *symbolic = cholmod_analyze(&lower, &common);
+    std::vector<int> camd(levels.size());
+    const bool       dissected = !levels.empty() && Eigen::Index(levels.size()) == K.rows() &&
+                           cholmod_camd(&lower, nullptr, 0, const_cast<int *>(levels.data()), camd.data(), &common);
+    if (dissected)
+      {
+        common.nmethods           = 1;
+        common.method[0].ordering = CHOLMOD_GIVEN;
+      }
+    cholmod_factor *symbolic =
+      dissected ? cholmod_analyze_p(&lower, camd.data(), nullptr, 0, &common) : cholmod_analyze(&lower, &common);
     if (symbolic == nullptr)
       throw std::runtime_error("CHOLMOD could not analyse the interior point's Newton matrix");
     const int *order = static_cast<const int *>(symbolic->Perm);

@@ -34,8 +34,11 @@ namespace tribo::dem
   {
   public:
     /// @p partition: the rows' halves for two threads (grain_bisection()); empty: K whole.
+    /// @p levels: with K whole, its rows' dissection levels (grain_dissection()), ordered
+    /// level by level by CAMD; empty: CHOLMOD's own ordering (AMD).
     explicit ShiftedFactorisation(const FrictionlessProblem::Scaled &p,
-                                  const std::vector<int> &partition = {});
+                                  const std::vector<int> &partition = {},
+                                  const std::vector<int> &levels    = {});
     /// Factorise K with this @p barrier (dimensionless, >= 0, one per contact); false if
     /// CHOLMOD fails (K numerically not positive definite).
     bool factorise(const Eigen::VectorXd &barrier);

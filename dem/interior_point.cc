@@ -64,10 +64,10 @@ namespace tribo::dem
     };
 
     // With two threads, K in two halves split along an edge cut of the grains (on one core
-    // the split costs more than it saves: K whole).
-    ShiftedFactorisation K(scaled, prm.threads > 1 && n >= BisectedCholesky::min_rows
-                                     ? grain_bisection(contacts, state)
-                                     : std::vector<int>{});
+    // the split costs more than it saves: K whole, ordered by a dissection of the grains).
+    const bool           halves = prm.threads > 1 && n >= BisectedCholesky::min_rows;
+    ShiftedFactorisation K(scaled, halves ? grain_bisection(contacts, state) : std::vector<int>{},
+                           halves ? std::vector<int>{} : grain_dissection(contacts, state));
     Eigen::VectorXd r(n), rhs(n), dy(n), ds(n), dy_a(n), ds_a(n), dy_c(n), ds_c(n);
     Eigen::VectorXd barrier(n); // s / y + shift, K's diagonal beyond A'
     auto solve = [&](const Eigen::VectorXd &v) { return K.solve(v); };

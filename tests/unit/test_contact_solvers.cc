@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <numeric>
 
 using namespace tribo::dem;
 
@@ -515,6 +517,37 @@ TEST(ContactSolvers, InteriorPointOnTwoThreadsGivesOneThreadsSolution)
           EXPECT_LT(std::abs(count[0] - count[1]), 0.05 * contacts.size());
           EXPECT_LT(count[2], 0.02 * contacts.size());
           EXPECT_TRUE(BisectedCholesky(lcp.scaled().A, part).split());
+          // One thread's order: 2100 grains dissected into 8 parts (3 levels of cuts). The
+          // contacts inside parts join the grains into at least 8 groups of at most a part's
+          // grains (METIS balances to a few per cent), and the cuts are few.
+          const std::vector<int> level = grain_dissection(contacts, state);
+          ASSERT_EQ(level.size(), contacts.size());
+          EXPECT_EQ(*std::max_element(level.begin(), level.end()), 3);
+          std::vector<unsigned int> group(runs[1].bodies.size());
+          std::iota(group.begin(), group.end(), 0U);
+          auto root = [&](unsigned int b) {
+            while (group[b] != b)
+              b = group[b] = group[group[b]];
+            return b;
+          };
+          std::size_t across = 0;
+          for (std::size_t i = 0; i < contacts.size(); ++i)
+            {
+              const unsigned int a = contacts[i].body[0], b = contacts[i].body[1];
+              if (level[i] > 0)
+                ++across;
+              else if (a != 0 && a != upper_wall && b != 0 && b != upper_wall)
+                group[root(a)] = root(b);
+            }
+          std::map<unsigned int, int> size;
+          for (unsigned int b = 1; b < upper_wall; ++b)
+            ++size[root(b)];
+          int largest = 0;
+          for (const auto &[r, count_r] : size)
+            largest = std::max(largest, count_r);
+          EXPECT_GE(size.size(), 8u);
+          EXPECT_LE(largest, 1.1 * (upper_wall - 1) / 8);
+          EXPECT_LT(across, 0.05 * contacts.size());
         }
     }
   double difference = 0, scale = 0;
