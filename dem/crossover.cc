@@ -99,11 +99,13 @@ namespace tribo::dem
     return t;
   }
 
-  Eigen::VectorXd ShiftedFactorisation::solve(const Eigen::VectorXd &v) const
+  Eigen::VectorXd ShiftedFactorisation::solve(const Eigen::VectorXd &v, bool refine) const
   {
     if (p.U.cols() == 0)
       return solve_sparse(v);
     Eigen::VectorXd t = woodbury(v);
+    if (!refine)
+      return t;
     t += woodbury(v - p.product(t) - barrier.cwiseProduct(t));
     return t;
   }

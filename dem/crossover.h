@@ -42,8 +42,9 @@ namespace tribo::dem
     /// Factorise K with this @p barrier (dimensionless, >= 0, one per contact); false if
     /// CHOLMOD fails (K numerically not positive definite).
     bool factorise(const Eigen::VectorXd &barrier);
-    /// K^-1 @p v with the last factorisation.
-    Eigen::VectorXd solve(const Eigen::VectorXd &v) const;
+    /// K^-1 @p v with the last factorisation; with walls, @p refine adds the step of
+    /// iterative refinement.
+    Eigen::VectorXd solve(const Eigen::VectorXd &v, bool refine = true) const;
     /// Numeric factorisations so far.
     unsigned int factorizations = 0;
 

@@ -13,6 +13,12 @@ namespace tribo::dem
     /// Gondzio's centrality correctors per iteration, at most (docs/performance.md: 2 cut
     /// the factorisations per step by 15 % on the 3800-grain benchmark).
     constexpr unsigned int centrality_correctors = 2;
+    /// With walls as low-rank terms, a Newton direction gets Woodbury's step of iterative
+    /// refinement only once the natural map is below this fraction of the mean impulse:
+    /// farther out the direction needs no more digits than Woodbury keeps, and the
+    /// refinement doubled the solves (docs/performance.md: 10 % of a step on the paper's
+    /// sample, the same steps at the round-off floor).
+    constexpr double refine_below = 1e-5;
 
     /// The crossover (dem/crossover.h): tried once the natural map is below this fraction
     /// of the mean impulse ...
@@ -70,7 +76,8 @@ namespace tribo::dem
                            halves ? std::vector<int>{} : grain_dissection(contacts, state));
     Eigen::VectorXd r(n), rhs(n), dy(n), ds(n), dy_a(n), ds_a(n), dy_c(n), ds_c(n);
     Eigen::VectorXd barrier(n); // s / y + shift, K's diagonal beyond A'
-    auto solve = [&](const Eigen::VectorXd &v) { return K.solve(v); };
+    bool refine_now = true; // below refine_below of the mean impulse (walls only)
+    auto solve = [&](const Eigen::VectorXd &v) { return K.solve(v, refine_now); };
     // Round-off floor: below 1e-6 of the mean impulse, two iterations in a row that do not
     // halve the natural map end the solve (K's condition grows like 1 / mu).
     double       worst = natural_map(), last_worst = std::numeric_limits<double>::infinity();
@@ -132,6 +139,7 @@ namespace tribo::dem
             report.converged = false;
             break;
           }
+        refine_now      = worst < refine_below * mean_loaded();
         r               = g - s;
         const double mu = y.dot(s) / n;
         // K is positive definite, but with A' singular (redundant contacts) and s_i / y_i
