@@ -19,17 +19,18 @@
 namespace tribo::dem
 {
   /// K = A' + diag(barrier) + U'U'^T of a scaled problem, factorised by CHOLMOD (simplicial
-  /// LL^T: 1.7 times faster than its supernodal one with Debian's reference BLAS on the
+  /// LL^T: twice as fast as its supernodal one with Debian's reference BLAS on the
   /// 3800-grain benchmark, docs/performance.md); given a @p partition of its rows (from 4000
   /// contacts, with a small separator), in two halves on both cores
   /// (dem/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
   /// each factorise() is one numeric factorisation. Whole, K is kept as the upper triangle
-  /// of P K P^T, P the analysis' fill-reducing ordering, so that CHOLMOD factorises it as
-  /// given: with its own ordering it would transpose K at every factorisation. A wall clump touched by m
-  /// contacts would make an m x m dense block: it stays out as U'U'^T, K_s = K - U'U'^T is
-  /// factorised and K solved by Woodbury, K^-1 v = K_s^-1 v - Z (I + U'^T Z)^-1 U'^T K_s^-1 v
-  /// with Z = K_s^-1 U', plus one step of iterative refinement against K (the update loses
-  /// digits that the plain factorisation keeps).
+  /// of P K P^T (permuted_upper()), P the fill-reducing ordering, so that CHOLMOD
+  /// factorises it as given: with its own ordering it would transpose K at every
+  /// factorisation. A wall clump touched by m contacts would make an m x m dense block: it
+  /// stays out as U'U'^T, K_s = K - U'U'^T is factorised and K solved by Woodbury,
+  /// K^-1 v = K_s^-1 v - Z (I + U'^T Z)^-1 U'^T K_s^-1 v with Z = K_s^-1 U', optionally
+  /// with one step of iterative refinement against K (the update loses digits that the
+  /// plain factorisation keeps).
   class ShiftedFactorisation
   {
   public:
