@@ -146,18 +146,18 @@ namespace tribo::app
                   << " s (step " << start << "; its sample_final.csv, without contact impulses)";
             log(state.str());
           }
-        if (!p.solver.unused_nlgs_entries.empty() && p.law.friction <= 0)
+        if (!p.solver.unused_nlgs_entries.empty() && (p.law.friction <= 0 || dem::solves_friction(p.solver.method)))
           {
             std::ostringstream unused;
             unused << "Solver/Method = " << dem::method_name(p.solver.method) << " stops at Solver/Residual target = "
                    << p.solver.residual_target << "; the NLGS entries " << p.solver.unused_nlgs_entries
-                   << " have no effect on this frictionless case (they act with Method = nlgs)";
+                   << " have no effect on this case (they act with Method = nlgs)";
             log(unused.str());
           }
-        if (p.solver.method != dem::SolverParameters::Method::nlgs && p.law.friction > 0)
+        if (!dem::solves_friction(p.solver.method) && p.law.friction > 0)
           log("Solver/Method = " + dem::method_name(p.solver.method) +
               " solves frictionless problems only: with Coulomb friction (mu = " +
-              std::to_string(p.law.friction) + ") every step uses NLGS");
+              std::to_string(p.law.friction) + ") every step uses NLGS (Method = apgs solves friction itself)");
         // What building the case cost: the modules a case does not use are not built (a
         // rigid wall builds no deal.II, SPH or MLP object).
         setup_time   = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -187,7 +187,8 @@ namespace tribo::app
             // its law residual.
             const auto method = prm.solver.method;
             const bool by_nlgs =
-              method == dem::SolverParameters::Method::nlgs || prm.law.friction > 0 || r.solver.fell_back;
+              method == dem::SolverParameters::Method::nlgs ||
+              (prm.law.friction > 0 && !dem::solves_friction(method)) || r.solver.fell_back;
             std::ostringstream os;
             os << "warning: step " << step << " (t = " << time() << " s): ";
             if (by_nlgs)

@@ -11,7 +11,7 @@
 
 namespace tribo::dem
 {
-  SolveReport ActiveSetSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
+  SolveReport ActiveSetSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
   {
     SolveReport report;
     const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());

@@ -35,7 +35,7 @@ namespace tribo::dem
     /// The report counts factorizations; if it is not converged within
     /// SolverParameters::max_factorizations, the contacts and the state are left as they
     /// came (the caller then solves with NLGS).
-    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
+    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &) override;
 
   private:
     const char *name() const override { return "active-set"; }

@@ -41,7 +41,7 @@ namespace tribo::dem
     constexpr double power_margin = 1.1;
   } // namespace
 
-  SolveReport ApgdSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
+  SolveReport ApgdSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
   {
     SolveReport report;
     const FrictionlessProblem   lcp(contacts, state, true);

@@ -1,6 +1,7 @@
 #include "dem/apgs.h"
 
 #include "dem/scaled_operator.h"
+#include "dem/sweep_problem.h"
 
 #include <deal.II/base/parallel.h>
 
@@ -10,20 +11,78 @@
 
 namespace tribo::dem
 {
-  SolveReport ApgsSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
+  SolveReport ApgsSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state,
+                                        const ContactLaw &law)
   {
-    SolveReport                 report;
-    const FrictionlessProblem   lcp(contacts, state, true);
-    const Eigen::Index          n      = lcp.size();
-    FrictionlessProblem::Scaled scaled = lcp.scaled();
-    const Eigen::VectorXd      &inv_root = scaled.inv_root;
-    const Eigen::VectorXd      &b        = scaled.b;
-    ScaledOperator              op(scaled);
+    SolveReport                        report;
+    const SweepProblem                 problem(contacts, state, law);
+    const FrictionlessProblem::Scaled &scaled   = problem.scaled;
+    const Eigen::Index                 n        = problem.n_contacts();
+    const Eigen::Index                 w        = problem.width; // rows w j, ..., w j + w - 1: contact j
+    const Eigen::Index                 rows     = w * n;
+    const Eigen::VectorXd             &inv_root = scaled.inv_root;
+    const Eigen::VectorXd             &b        = scaled.b;
+    ScaledOperator                     op(scaled);
+
+    // Contact j's natural map in N s/m, y's rows set in op: without friction
+    // |min(y_j, g_j)| / sqrt(D_j); with friction the norm of (phi_n, phi_t) of
+    // dem/law_residual.h in the scaled variables (unit normal diagonal, tangent diagonal
+    // A'_tt), times the contact's scale.
+    auto contact_map = [&](const Eigen::VectorXd &y, Eigen::Index j) {
+      if (w == 1)
+        return std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
+      const Eigen::Index k      = 2 * j;
+      const double       g_n    = op.row_times(y, k) + b[k], g_t = op.row_times(y, k + 1) + b[k + 1];
+      const double       r_law  = std::max(0.0, y[k] - g_n);
+      const double       bound  = problem.friction * r_law;
+      const double       phi_n  = y[k] - r_law;
+      const double       phi_t  = y[k + 1] - std::clamp(y[k + 1] - g_t / problem.own_block[j](1, 1), -bound, bound);
+      return std::sqrt(phi_n * phi_n + phi_t * phi_t) * inv_root[k];
+    };
+    // Contact j's local solve in v (rows set in op), the low-rank product kept current and,
+    // with @p also, the same changes added to it: without friction v_j = max(0, v_j - g_j)
+    // (unit diagonal); with friction the exact 2x2 Coulomb solve against the contact's own
+    // block B, u = B v_j + q (ContactLaw::solve_coulomb; v_j = 0 if q_n >= 0).
+    auto relax = [&](Eigen::VectorXd &v, Eigen::Index j, Eigen::VectorXd *also) {
+      if (w == 1)
+        {
+          const double next = std::max(0.0, v[j] - (op.row_times(v, j) + b[j]));
+          if (next != v[j])
+            {
+              op.add_to_low_rank(j, next - v[j]);
+              if (also)
+                (*also)[j] += next - v[j];
+              v[j] = next;
+            }
+          return;
+        }
+      const Eigen::Index     k = 2 * j;
+      const Eigen::Matrix2d &B = problem.own_block[j];
+      const double q_n = op.row_times(v, k) + b[k] - B(0, 0) * v[k] - B(0, 1) * v[k + 1];
+      const double q_t = op.row_times(v, k + 1) + b[k + 1] - B(1, 0) * v[k] - B(1, 1) * v[k + 1];
+      const Eigen::Vector2d next = q_n < 0 ? law.solve_coulomb(B(0, 0), B(0, 1), B(1, 0), B(1, 1), q_n, q_t)
+                                           : Eigen::Vector2d::Zero();
+      for (int p = 0; p < 2; ++p)
+        if (next[p] != v[k + p])
+          {
+            op.add_to_low_rank(k + p, next[p] - v[k + p]);
+            if (also)
+              (*also)[k + p] += next[p] - v[k + p];
+            v[k + p] = next[p];
+          }
+    };
+    // Whether a row of contact j has low-rank entries (a wall's contact).
+    auto on_low_rank = [&](Eigen::Index j) {
+      for (Eigen::Index k = w * j; k < w * j + w; ++k)
+        if (op.has_low_rank(k))
+          return true;
+      return false;
+    };
 
     // The natural map at y over its mean loaded impulse (one product); each contact's
-    // |min(y_j, g_j)| / sqrt(D_j) is kept in `error` and the mean in `mean_loaded` (N s/m).
+    // map is kept in `error` and the mean in `mean_loaded` (N s/m).
     Eigen::VectorXd error(n);
-    double          mean_loaded = lcp.scale;
+    double          mean_loaded = problem.scale;
     // Over fixed chunks (dem/scaled_operator.h), concurrently with Threads > 1, merged in
     // chunk order: the same bits on any number of threads. The chunks' sums are kept, so
     // that the check after a polish recomputes only the chunks that hold a changed row.
@@ -46,11 +105,11 @@ namespace tribo::dem
       for (Eigen::Index j = first; j < last; ++j)
         {
           if (!affected || (*affected)[j])
-            error[j] = std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
+            error[j] = contact_map(y, j);
           part.worst = std::max(part.worst, error[j]);
-          if (y[j] > 0)
+          if (y[w * j] > 0)
             {
-              part.loaded_sum += y[j] * inv_root[j];
+              part.loaded_sum += y[w * j] * inv_root[w * j];
               ++part.loaded;
             }
         }
@@ -58,7 +117,7 @@ namespace tribo::dem
     };
     auto merged_map = [&]() {
       const MapSums sums = merged_in_order(chunk_sums);
-      mean_loaded        = sums.loaded > 0 ? sums.loaded_sum / sums.loaded : lcp.scale;
+      mean_loaded        = sums.loaded > 0 ? sums.loaded_sum / sums.loaded : problem.scale;
       return sums.worst / mean_loaded;
     };
     // A whole check: one pass.
@@ -75,7 +134,7 @@ namespace tribo::dem
     // When no contact couples two slabs that are not neighbours and the walls' low-rank rows
     // lie in one slab, the slabs of one colour share nothing and run concurrently, with the
     // same bits on any number of threads; otherwise one slab holds every contact.
-    std::vector<Eigen::Index> slab_start{0, n};
+    std::vector<Eigen::Index> slab_start{0, n}; // in contacts
     {
       const Eigen::Index count = std::max<Eigen::Index>(1, std::min<Eigen::Index>(slab_count, n / 64) / 2 * 2);
       std::vector<Eigen::Index> start(count + 1);
@@ -86,12 +145,12 @@ namespace tribo::dem
       };
       bool         separate = count >= 2;
       Eigen::Index low_rank_slab = -1;
-      for (Eigen::Index j = 0; j < n && separate; ++j)
+      for (Eigen::Index k = 0; k < rows && separate; ++k)
         {
-          const Eigen::Index s = slab_of(j);
-          for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a && separate; ++a)
-            separate = std::abs(slab_of(a.row()) - s) <= 1;
-          if (op.has_low_rank(j))
+          const Eigen::Index s = slab_of(k / w);
+          for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, k); a && separate; ++a)
+            separate = std::abs(slab_of(a.row() / w) - s) <= 1;
+          if (op.has_low_rank(k))
             {
               separate = separate && (low_rank_slab < 0 || low_rank_slab == s);
               low_rank_slab = s;
@@ -102,17 +161,10 @@ namespace tribo::dem
     }
     const Eigen::Index slabs = Eigen::Index(slab_start.size()) - 1;
     report.concurrent        = slabs > 1 && prm.threads > 1;
-    // One projected Gauss-Seidel sweep of v in place (unit diagonal: A'_jj + |U'_j|^2 = 1).
+    // One projected Gauss-Seidel sweep of v in place.
     auto sweep_slab = [&](Eigen::VectorXd &v, Eigen::Index q) {
       for (Eigen::Index j = slab_start[q]; j < slab_start[q + 1]; ++j)
-        {
-          const double next = std::max(0.0, v[j] - (op.row_times(v, j) + b[j]));
-          if (next != v[j])
-            {
-              op.add_to_low_rank(j, next - v[j]);
-              v[j] = next;
-            }
-        }
+        relax(v, j, nullptr);
     };
     auto sweep = [&](Eigen::VectorXd &v) {
       ++report.iterations;
@@ -163,12 +215,13 @@ namespace tribo::dem
         {
           const std::size_t inner = local.size();
           for (std::size_t q = std::exchange(last_ring, inner); q < inner; ++q)
-            for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, local[q]); a; ++a)
-              if (!marked[a.row()])
-                {
-                  marked[a.row()] = 1;
-                  local.push_back(a.row());
-                }
+            for (Eigen::Index k = w * local[q]; k < w * local[q] + w; ++k)
+              for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, k); a; ++a)
+                if (!marked[a.row() / w])
+                  {
+                    marked[a.row() / w] = 1;
+                    local.push_back(a.row() / w);
+                  }
         }
       for (const Eigen::Index j : local)
         marked[j] = 0;
@@ -178,26 +231,19 @@ namespace tribo::dem
       op.set_vector(y);
       for (unsigned int pass = 0; pass < polish_passes; ++pass)
         for (const Eigen::Index j : local)
-          {
-            const double next = std::max(0.0, y[j] - (op.row_times(y, j) + b[j]));
-            if (next != y[j])
-              {
-                op.add_to_low_rank(j, next - y[j]);
-                z[j] += next - y[j];
-                y[j] = next;
-              }
-          }
+          relax(y, j, &z);
       bool wall = false;
       for (const Eigen::Index j : local)
         {
-          for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, j); a; ++a)
-            affect(a.row());
+          for (Eigen::Index k = w * j; k < w * j + w; ++k)
+            for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, k); a; ++a)
+              affect(a.row() / w);
           affect(j);
-          wall = wall || op.has_low_rank(j);
+          wall = wall || on_low_rank(j);
         }
       if (wall)
-        for (const Eigen::Index j : op.low_rank_row_list())
-          affect(j);
+        for (const Eigen::Index k : op.low_rank_row_list())
+          affect(k / w);
       return true;
     };
     // The check after a polish: the chunks that hold an affected row are recomputed, the
@@ -225,12 +271,18 @@ namespace tribo::dem
       return merged_map();
     };
 
-    Eigen::VectorXd y = scaled.y.cwiseMax(0.0), y_last(n), z = y, next(n);
+    Eigen::VectorXd y = w == 1 ? Eigen::VectorXd(scaled.y.cwiseMax(0.0)) : scaled.y, y_last(rows), z = y, next(rows);
     double          t        = 1;
     // Polishes since the last block of sweeps, and since the lowest map among them.
     unsigned int polished = 0, since_lowest = 0;
     double       lowest   = INFINITY;
     double       map      = relative_map(y);
+    // With friction (width 2) the sweep is no gradient step of a potential (the law is not
+    // associated) and the momentum has no guarantee: the safeguard keeps the best iterate
+    // of the whole checks, drops the momentum when a block raises the map, and returns the
+    // best iterate if the solve ends above it.
+    Eigen::VectorXd best       = w == 2 ? y : Eigen::VectorXd();
+    double          best_map   = map, block_map = map;
     while (map > prm.residual_target)
       {
         if (report.iterations >= prm.max_iterations)
@@ -259,7 +311,7 @@ namespace tribo::dem
         for (unsigned int k = 0; k < check_interval; ++k)
           {
             sweep(next);
-            const double opposed = over_chunks<Sum>(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+            const double opposed = over_chunks<Sum>(rows, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
               Sum part;
               for (Eigen::Index j = first; j < last; ++j)
                 part.value += (z[j] - next[j]) * (next[j] - y[j]);
@@ -271,7 +323,7 @@ namespace tribo::dem
             const double beta   = (t - 1) / t_next;
             y_last.swap(y);
             y.swap(next);
-            over_chunks<NoSums>(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+            over_chunks<NoSums>(rows, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
               for (Eigen::Index j = first; j < last; ++j)
                 next[j] = z[j] = y[j] + beta * (y[j] - y_last[j]);
               return NoSums{};
@@ -279,8 +331,25 @@ namespace tribo::dem
             t = t_next;
           }
         map = relative_map(y);
+        if (w == 2)
+          {
+            if (map < best_map)
+              {
+                best     = y;
+                best_map = map;
+              }
+            else if (map > block_map)
+              {
+                ++report.restarts;
+                t = 1;
+                z = y;
+              }
+            block_map = map;
+          }
       }
-    lcp.apply(y.cwiseProduct(inv_root), contacts, state);
+    if (w == 2 && best_map < map)
+      y = best; // the safeguard's best iterate (its map is best_map)
+    problem.apply(y, contacts, state);
     return report;
   }
 } // namespace tribo::dem

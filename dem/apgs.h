@@ -1,6 +1,8 @@
 #pragma once
 /// @file APGS, the accelerated projected Gauss-Seidel method, on the frictionless contact
-/// problem (dem/frictionless_problem.h): min f(x) = x.A x / 2 + b.x over x >= 0.
+/// problem (dem/frictionless_problem.h): min f(x) = x.A x / 2 + b.x over x >= 0, and on
+/// the problem with Coulomb friction (dem/sweep_problem.h), whose sweeps solve each
+/// contact's 2x2 law exactly (ContactLaw::solve_coulomb()).
 ///
 /// In the scaled variables of APGD (dem/apgd.h: y = D^(1/2) x, the operator A' + U'U'^T
 /// with unit diagonal, b' = D^(-1/2) b, g = A'y + b'), one projected Gauss-Seidel sweep
@@ -39,6 +41,16 @@
 /// whole sweeps spent on that tail are what made the sweeps grow with the width, and the
 /// polish works on it alone (docs/performance.md, "APGS's local polish").
 ///
+/// With friction a contact is two rows (normal, tangent) and its natural map the norm of
+/// (phi_n, phi_t) of dem/law_residual.h, so the stopping test is the law residual itself.
+/// The 2D Coulomb law is not associated: the sweep is no projected gradient step of a
+/// potential and the momentum has no guarantee. A safeguard keeps the best iterate of the
+/// whole checks and drops the momentum (t = 1, z = y) when a block of sweeps raises the map;
+/// a solve that runs out of iterations returns the best iterate. (Going back to the best
+/// iterate during the solve was tried: the sweeps, deterministic, then retrace the same
+/// rise and the solve never leaves it.) The sweeps' floor is near a law residual of 1e-9:
+/// the local solve accepts its cases within a relative 1e-10 (ContactLaw::solve_coulomb()).
+///
 /// A sweep carries a change along a whole force chain in the contacts' order, as NLGS does,
 /// and the momentum accelerates it as APGD's accelerates the gradient (docs/performance.md:
 /// on one core 0.51-0.67 times APGD's time per step at a residual of 1e-4 from 1000 to
@@ -73,9 +85,11 @@ namespace tribo::dem
     static constexpr double polish_fraction = 0.05;
     /// The report's iterations are the sweeps plus the whole checks (one product each); the
     /// polishes and their checks of the polished rows are not counted.
-    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
+    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state,
+                              const ContactLaw &law) override;
 
   private:
+    bool        solves_friction() const override { return true; }
     const char *name() const override { return "APGS"; }
   };
 } // namespace tribo::dem

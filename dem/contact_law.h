@@ -30,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -121,7 +122,8 @@ namespace tribo::dem
     /// |r~_t| < mu r~_n, else r~_t = -mu r~_n sign(u_t). Enumerates the cases in the
     /// order stick (u = 0), slide with s = sign of the stick trial's r~_t, slide with -s
     /// (u_n = 0, r~_t = s mu r~_n, r~_n = -q_n / (W~_nn + s mu W~_nt), valid if r~_n >= 0
-    /// and s u_t <= 0), and returns the first that satisfies the law. A coupled block
+    /// and s u_t <= 0), and returns the first that satisfies the law (a stick accepted within
+    /// round-off of the cone's edge is put on the edge: the returned impulse is in the cone). A coupled block
     /// (W_nt != 0: clumps, half-discs) can make the stick trial's sign wrong, and its
     /// sliding denominator vanish or turn negative; the enumeration handles both.
     /// Throws RunError, with the block and q, if no case satisfies the law.
@@ -136,7 +138,7 @@ namespace tribo::dem
           const double rn = (-qn * Wtt + qt * Wnt) / det;
           const double rt = (-qt * Wnn + qn * Wtn) / det;
           if (rn >= 0 && std::abs(rt) <= friction * rn * (1 + tol))
-            return {rn, rt};
+            return {rn, std::clamp(rt, -friction * rn, friction * rn)}; // on the cone within round-off
           s = rt >= 0 ? 1.0 : -1.0;
         }
       for (const double sign : {s, -s})

@@ -87,8 +87,9 @@ namespace tribo::dem
   {
     if (contacts.empty())
       return {};
-    require_frictionless(law, name());
-    return solve_problem(contacts, state);
+    if (!solves_friction())
+      require_frictionless(law, name());
+    return solve_problem(contacts, state, law);
   }
 
   void require_frictionless(const ContactLaw &law, const std::string &method)

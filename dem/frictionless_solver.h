@@ -16,17 +16,21 @@ namespace tribo::dem
   public:
     explicit FrictionlessSolver(const SolverParameters &p = {}) : prm(p) {}
     virtual ~FrictionlessSolver() = default;
-    /// Solve the frictionless problem of @p contacts (warm-started from their r, whose
+    /// Solve the contact problem of @p contacts (warm-started from their r, whose
     /// effect must already be in @p state), updating their impulses and @p state: an
     /// empty report without contacts, else solve_problem(). Throws RunError naming the
-    /// method if @p law has friction. What the report counts: each method says.
+    /// method if @p law has friction and the method does not solve it
+    /// (solves_friction()). What the report counts: each method says.
     SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law);
 
   protected:
     /// The method's name in messages ("MPRGP").
     virtual const char *name() const = 0;
-    /// Solve the problem of @p contacts (not empty).
-    virtual SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) = 0;
+    /// Whether the method solves the law with Coulomb friction (APGS) or only without.
+    virtual bool solves_friction() const { return false; }
+    /// Solve the problem of @p contacts (not empty) under @p law.
+    virtual SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state,
+                                      const ContactLaw &law) = 0;
 
     SolverParameters prm;
   };

@@ -39,7 +39,7 @@ namespace tribo::dem
     }
   } // namespace
 
-  SolveReport InteriorPointSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
+  SolveReport InteriorPointSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
   {
     SolveReport report;
     const FrictionlessProblem lcp(contacts, state, true);

@@ -50,7 +50,7 @@ namespace tribo::dem
   public:
     using FrictionlessSolver::FrictionlessSolver;
     /// The report counts factorizations.
-    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
+    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &) override;
 
   private:
     const char *name() const override { return "interior-point"; }

@@ -53,7 +53,8 @@ namespace tribo::dem
 
   bool MoreauJean::global_method() const
   {
-    return solver.parameters().method != SolverParameters::Method::nlgs && contact_law.friction <= 0;
+    const SolverParameters::Method method = solver.parameters().method;
+    return method != SolverParameters::Method::nlgs && (contact_law.friction <= 0 || solves_friction(method));
   }
 
   SolveReport MoreauJean::solve_contacts(double h)

@@ -138,8 +138,8 @@ namespace tribo::dem
     void load(CheckpointIn &ar);
 
   private:
-    /// Whether the step is solved by a global method (active set, MPRGP): chosen, and
-    /// the law frictionless.
+    /// Whether the step is solved by a global method: one is chosen, and the law is
+    /// frictionless or the method solves friction (APGS); otherwise NLGS solves it.
     bool global_method() const;
     /// The contact impulses of the current step by the chosen method (its predictor
     /// sweeps included), updating state.

@@ -46,7 +46,7 @@ namespace tribo::dem
     };
   } // namespace
 
-  SolveReport MprgpSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state)
+  SolveReport MprgpSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
   {
     SolveReport report;
     // The walls (bodies with many contacts) as low-rank terms: A' + U'U'^T, so that a

@@ -41,7 +41,7 @@ namespace tribo::dem
   public:
     using FrictionlessSolver::FrictionlessSolver;
     /// The report's iterations are the products with the Delassus operator.
-    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state) override;
+    SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &) override;
 
   private:
     const char *name() const override { return "MPRGP"; }

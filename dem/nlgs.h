@@ -40,7 +40,8 @@ namespace tribo::dem
     /// by CHOLMOD (dem/active_set.h), the matrix-free MPRGP (dem/mprgp.h) and APGD
     /// (dem/apgd.h), APGS, Gauss-Seidel sweeps with momentum (dem/apgs.h), or the primal-dual interior-point method, also with CHOLMOD
     /// (dem/interior_point.h). With
-    /// friction the global methods hand the step to NLGS and say so.
+    /// friction APGS solves the Coulomb law itself (solves_friction()); the other global
+    /// methods hand the step to NLGS and say so.
     enum class Method
     {
       nlgs,
@@ -134,6 +135,13 @@ namespace tribo::dem
     static SolverParameters parse(const ParameterFile &file, const std::string &section);
   };
 
+  /// Whether @p method solves the law with Coulomb friction itself (NLGS and APGS); the
+  /// other methods hand a frictional step to NLGS.
+  inline bool solves_friction(SolverParameters::Method method)
+  {
+    return method == SolverParameters::Method::nlgs || method == SolverParameters::Method::apgs;
+  }
+
   /// The name of @p method as the Method entry (SolverParameters::declare()) spells it.
   inline std::string method_name(SolverParameters::Method method)
   {
@@ -172,6 +180,9 @@ namespace tribo::dem
     /// (false: they shared a body and were solved serially, in the same order).
     bool concurrent = false;
     bool         converged  = true;
+    /// APGS with friction: blocks of sweeps whose map rose, after which the safeguard
+    /// dropped the momentum (dem/apgs.h).
+    unsigned int restarts = 0;
     /// The achieved criterion: max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm
     /// ones) times tol, i.e. the relative quantity that is compared with tol.
     double residual = 0;

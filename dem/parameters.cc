@@ -76,8 +76,9 @@ namespace tribo::dem
                       "factorised by CHOLMOD), 'mprgp' (matrix-free projected conjugate gradient with "
                       "proportioning) or "
                       "'interior-point' (Mehrotra's predictor-corrector, CHOLMOD: the one that "
-                      "reaches 1e-8 on dense packings). All but nlgs stop at Residual target; with "
-                      "friction their steps use NLGS and the log says so.");
+                      "reaches 1e-8 on dense packings). All but nlgs stop at Residual target; "
+                      "nlgs and apgs solve Coulomb friction, with friction the others' steps use "
+                      "NLGS and the log says so.");
     prm.declare_entry("Residual target", "1e-3", Double(),
                       "Active set, MPRGP, interior point, APGD, APGS: the solve ends when the law residual, max over "
                       "contacts of |min(r~, u~ / W_nn)| over the mean loaded impulse r~ "

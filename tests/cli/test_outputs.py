@@ -610,12 +610,12 @@ class Compaction(ShearRun, unittest.TestCase):
 
     def test_default_method_and_the_nlgs_entry_it_ignores(self):
         """The default method is APGS; the case's Solver/Tolerance, an NLGS entry, is named
-        in the log as having no effect on this frictionless case."""
+        in the log as having no effect on this case."""
         self.assertEqual(self.summary["solver_method"], "apgs")
         with open(os.path.join(self.out, "log.txt")) as f:
             log = f.read()
         self.assertRegex(log, r"Solver/Method = apgs stops at Solver/Residual target = 0\.001; the NLGS entries "
-                         r"Solver/Tolerance \(case\.prm:\d+\) have no effect on this frictionless case "
+                         r"Solver/Tolerance \(case\.prm:\d+\) have no effect on this case "
                          r"\(they act with Method = nlgs\)")
 
     def test_no_profiles(self):

@@ -434,12 +434,14 @@ TEST(ContactSolvers, GlobalMethodsWithElasMatchConvergedNlgs)
     }
 }
 
-TEST(ContactSolvers, GlobalMethodsWithFrictionUseNlgs)
+TEST(ContactSolvers, GlobalMethodsWithoutAFrictionalSolveUseNlgs)
 {
   ContactLaw law;
   law.friction = 0.3;
   for (const SolverParameters &prm : global_methods())
     {
+      if (solves_friction(prm.method))
+        continue;
       std::vector<SolveReport> reports;
       const Eigen::VectorXd v     = velocities_after(hexagonal_stack(400, 2), law, prm, 5, &reports);
       const Eigen::VectorXd v_ref = velocities_after(hexagonal_stack(400, 2), law, SolverParameters{}, 5);
@@ -450,6 +452,205 @@ TEST(ContactSolvers, GlobalMethodsWithFrictionUseNlgs)
           EXPECT_GT(r.iterations, 0u);
         }
     }
+}
+
+namespace
+{
+  /// APGS to a law residual of 1e-8 (the frictional local solve accepts its cases to a
+  /// relative 1e-10, ContactLaw::solve_coulomb(): the sweeps' floor is near 1e-9).
+  SolverParameters frictional_apgs()
+  {
+    SolverParameters apgs;
+    apgs.method          = SolverParameters::Method::apgs;
+    apgs.residual_target = 1e-8;
+    apgs.max_iterations  = 100000;
+    return apgs;
+  }
+
+  /// Every step of @p reports converged, by the method itself, to a law residual (friction
+  /// term included, measured from the bodies' velocities) below twice @p target.
+  void expect_law_solved(const std::vector<SolveReport> &reports, double target = 1e-8)
+  {
+    for (const auto &r : reports)
+      {
+        EXPECT_TRUE(r.converged) << r.iterations << " " << r.law_residual << " " << r.restarts;
+        EXPECT_FALSE(r.fell_back);
+        EXPECT_EQ(r.factorizations, 0u);
+        EXPECT_LT(r.law_residual, 2 * target);
+      }
+  }
+} // namespace
+
+TEST(ContactSolvers, FrictionalMethodsGiveTheClosedFormOfADiscLandingOnASlidingWall)
+{
+  // A disc (radius R, mass m, I = m R^2 / 2) lands on a wall clump sliding at V. In the
+  // contact's frame at the predicted configuration (n from the wall disc to the disc,
+  // t = (-n_y, n_x), gap g < 0, the contact point at a = R + g / 2 from the disc's centre)
+  // the contact point's relative velocity is u0 = (n, t).(v0 + w0 k x (-a n) - V) and
+  // W = diag(1/m, 1/m + a^2 / I). IQS closes the contact (the predicted gap is an overlap:
+  // u_n = 0), P_n = -m u_n0; P_t = -u_t0 / W_tt (stick, rolling) if |P_t| <= mu P_n, else
+  // -mu P_n sign(u_t0) (slip). Then v = v0 + (P_n n + P_t t) / m, w = w0 - a P_t / I.
+  const double mu = 0.4, V = 1.5, vy0 = -2, w0 = 1e5;
+  for (const double vx0 : {1.6, 0.2, 3.0, -2.0})
+    for (SolverParameters prm : {nlgs_converged(), frictional_apgs()})
+      {
+        ParticleSystem s;
+        const unsigned wall = s.add_clump({{0, 0}, {2 * radius, 0}}, {radius, radius}, rho);
+        for (auto &k : s.bodies[wall].drive)
+          k = Drive::velocity;
+        s.bodies[wall].velocity = {V, 0};
+        const unsigned disc     = s.add_disc({0, 2 * radius}, radius, rho);
+        s.bodies[disc].velocity = {vx0, vy0};
+        s.bodies[disc].spin     = w0;
+        ContactLaw law;
+        law.friction = mu;
+        MoreauJean       mj(0.5, law, prm, 0.1 * radius);
+        const StepReport report = mj.step(s, h);
+
+        const double m = M_PI * radius * radius * rho, I = m * radius * radius / 2;
+        const Vec2   branch = Vec2(0.5 * h * vx0, 2 * radius + 0.5 * h * vy0) - Vec2(0.5 * h * V, 0);
+        const Vec2   n      = branch.normalized();
+        const Vec2   t(-n.y(), n.x());
+        const double a     = radius + 0.5 * (branch.norm() - 2 * radius);
+        const Vec2   v_rel = Vec2(vx0, vy0) - w0 * a * t - Vec2(V, 0);
+        const double Pn = -m * n.dot(v_rel), stick = -t.dot(v_rel) / (1 / m + a * a / I);
+        const double Pt = std::abs(stick) <= mu * Pn ? stick : (stick > 0 ? mu * Pn : -mu * Pn);
+        const Vec2   v  = Vec2(vx0, vy0) + (Pn * n + Pt * t) / m;
+        EXPECT_EQ(report.n_active, 1u);
+        EXPECT_LT((s.bodies[disc].velocity - v).norm(), 1e-12 * v.norm()) << method_name(prm.method) << " " << vx0;
+        EXPECT_NEAR(s.bodies[disc].spin, w0 - a * Pt / I, 1e-12 * w0) << method_name(prm.method) << " " << vx0;
+      }
+}
+
+TEST(ContactSolvers, FrictionalApgsSolvesTheLawOnAShearedHyperstaticStack)
+{
+  // The lower wall slides at 2 m/s under a load: contacts stick and slip, the walls (clumps,
+  // low-rank columns) couple the normal and tangential rows. With friction the velocities of
+  // this packing are not unique (NLGS and APGS, both to 1e-12, end 10-60 % apart after one
+  // step: two solutions of one law), so the test is the law itself, measured from the bodies.
+  // The sweeps' floor on this thin, fast-sheared stack rises to 1e-8 within 40 steps.
+  ContactLaw law;
+  law.friction = 0.3;
+  std::vector<SolveReport> reports;
+  SolverParameters         prm = frictional_apgs();
+  prm.residual_target          = 1e-6;
+  velocities_after(hexagonal_stack(400, 2), law, prm, 40, &reports);
+  expect_law_solved(reports, prm.residual_target);
+  EXPECT_GT(reports.back().iterations, 1u);
+}
+
+TEST(ContactSolvers, FrictionalApgsSolvesTheLawOnACohesiveCluster)
+{
+  // Friction on the shifted impulse r_n + gamma h: bonds in tension still carry a tangential
+  // impulse. Not unique either (NLGS's velocities differ by more than their norm).
+  ContactLaw law;
+  law.friction       = 0.3;
+  law.cohesion       = 50;
+  law.cohesion_range = 0.05 * radius;
+  std::vector<SolveReport> reports;
+  velocities_after(hexagonal_stack(-200, 1), law, frictional_apgs(), 30, &reports);
+  expect_law_solved(reports);
+}
+
+TEST(ContactSolvers, FrictionalApgsMatchesConvergedNlgsWithElas)
+{
+  // ELAS's compliance makes the solution unique.
+  ContactLaw law;
+  law.type      = ContactLaw::Type::elas;
+  law.stiffness = 1e9;
+  law.friction  = 0.3;
+  std::vector<SolveReport> reports;
+  const Eigen::VectorXd    v_nlgs = velocities_after(hexagonal_stack(400, 1), law, nlgs_converged(), 30);
+  const Eigen::VectorXd    v      = velocities_after(hexagonal_stack(400, 1), law, frictional_apgs(), 30, &reports);
+  EXPECT_LT((v - v_nlgs).norm(), 1e-6 * v_nlgs.norm());
+  expect_law_solved(reports);
+}
+
+TEST(ContactSolvers, FrictionalApgsGivesTheSameBitsOnTwoThreads)
+{
+  // Without NLGS's predictor sweeps, whose bands change their order with the threads.
+  ContactLaw law;
+  law.friction = 0.3;
+  SolverParameters prm;
+  prm.method           = SolverParameters::Method::apgs;
+  prm.predictor_sweeps = 0;
+  std::vector<SolveReport> one, two;
+  const Eigen::VectorXd    v1 = velocities_after(hexagonal_stack(3600, 2, 180), law, prm, 10, &one);
+  prm.threads                 = 2;
+  const Eigen::VectorXd v2    = velocities_after(hexagonal_stack(3600, 2, 180), law, prm, 10, &two);
+  EXPECT_EQ(v1, v2);
+}
+
+namespace
+{
+  /// One contact between a fixed body 0 and a disc 1 (mass 2 kg/m, moment 0.5 kg m, arms
+  /// @p arm_n and @p arm_t): normal (0, 1), tangent (-1, 0). Its impulse is @p r and the
+  /// disc's velocity gives the local velocity @p u; returns the law residual under @p law.
+  LawResidual one_contact_residual(const ContactLaw &law, const Eigen::Vector2d &r, const Eigen::Vector2d &u,
+                                   double arm_n = 0, double arm_t = 0.5)
+  {
+    BodyState state;
+    state.velocity     = {Eigen::Vector3d::Zero(), Eigen::Vector3d(-u.y(), u.x(), 0)};
+    state.inverse_mass = {{{0, 0, 0}}, {{0.5, 0.5, 2}}};
+    Contact c;
+    c.body[0] = 0;
+    c.body[1] = 1;
+    c.normal  = Vec2(0, 1);
+    c.arm_n[1] = arm_n;
+    c.arm_t[1] = arm_t;
+    c.W        = state.delassus_block(c);
+    c.r        = r;
+    return law_residual({c}, state, law, 0);
+  }
+} // namespace
+
+TEST(ContactSolvers, LawResidualsFrictionTermMatchesClosedForms)
+{
+  ContactLaw law;
+  law.friction = 0.3;
+  // W = diag(1/m, 1/m + arm_t^2 / I) = diag(0.5, 1): rho_t = 1 / W_tt = 1 s/m per N s/m.
+  // Stick: |r_t| < mu r_n with u = 0 is the law; a slip u_t left in it costs u_t / W_tt.
+  EXPECT_EQ(one_contact_residual(law, {1, 0.2}, {0, 0}).max_phi, 0.0);
+  EXPECT_NEAR(one_contact_residual(law, {1, 0.2}, {0, 0.05}).max_phi, 0.05, 1e-15);
+  // Slip: r_t = -mu r_n sign(u_t) is the law whatever |u_t|.
+  EXPECT_EQ(one_contact_residual(law, {1, -0.3}, {0, 0.4}).max_phi, 0.0);
+  EXPECT_EQ(one_contact_residual(law, {1, 0.3}, {0, -7.0}).max_phi, 0.0);
+  // Sliding against the wrong sign: phi_t = r_t - proj(r_t - u_t / W_tt) = 0.4, then 2 mu r_n.
+  EXPECT_NEAR(one_contact_residual(law, {1, 0.3}, {0, 0.4}).max_phi, 0.4, 1e-15);
+  EXPECT_NEAR(one_contact_residual(law, {1, 0.3}, {0, 1.0}).max_phi, 0.6, 1e-15);
+  // Outside the cone at rest: |r_t| - mu r_n.
+  EXPECT_NEAR(one_contact_residual(law, {1, 0.5}, {0, 0}).max_phi, 0.2, 1e-15);
+  // Relative to the mean loaded impulse.
+  EXPECT_NEAR(one_contact_residual(law, {2, 0.3}, {0, 0.1}).relative, 0.1 / 2, 1e-15);
+  // The friction term needs friction: the same slip, frictionless, is only the normal term's.
+  EXPECT_EQ(one_contact_residual(ContactLaw{}, {1, 0.2}, {0, 0.05}).max_phi, 0.0);
+
+  // The coupled block (W_nt != 0: an arm along the normal, as on a clump): every solution of
+  // the local problem solve_coulomb() returns has a zero residual, in stick and in slip.
+  const double arm_n = 0.2, arm_t = 0.5;
+  BodyState    probe;
+  probe.velocity     = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  probe.inverse_mass = {{{0, 0, 0}}, {{0.5, 0.5, 2}}};
+  Contact c;
+  c.body[1]                 = 1;
+  c.normal                  = Vec2(0, 1);
+  c.arm_n[1]                = arm_n;
+  c.arm_t[1]                = arm_t;
+  const Eigen::Matrix2d W   = probe.delassus_block(c);
+  ASSERT_NEAR(W(0, 1), 2 * arm_n * arm_t, 1e-15);
+  for (const Eigen::Vector2d &q : {Eigen::Vector2d(-1, 0.01), Eigen::Vector2d(-1, 0.5), Eigen::Vector2d(-1, -2)})
+    {
+      const Eigen::Vector2d r = law.solve_coulomb(W(0, 0), W(0, 1), W(1, 0), W(1, 1), q.x(), q.y());
+      const Eigen::Vector2d u = W * r + q;
+      EXPECT_LT(one_contact_residual(law, r, u, arm_n, arm_t).max_phi, 1e-12 * r.norm()) << q.transpose();
+      EXPECT_LE(std::abs(r.y()), law.friction * r.x() * (1 + 1e-12));
+    }
+  // q_t = 0.01: stick (u = 0); q_t = 0.5 and -2: slip opposite to the sliding velocity.
+  const Eigen::Vector2d stick = law.solve_coulomb(W(0, 0), W(0, 1), W(1, 0), W(1, 1), -1, 0.01);
+  EXPECT_LT((W * stick + Eigen::Vector2d(-1, 0.01)).norm(), 1e-14);
+  const Eigen::Vector2d slip = law.solve_coulomb(W(0, 0), W(0, 1), W(1, 0), W(1, 1), -1, 0.5);
+  EXPECT_NEAR(slip.y(), -law.friction * slip.x(), 1e-15);
+  EXPECT_GT((W * slip + Eigen::Vector2d(-1, 0.5)).y(), 0);
 }
 
 TEST(ContactSolvers, InteriorPointReachesATightTargetAtEveryWarmStartedStepOfAHyperstaticStack)
