@@ -84,7 +84,7 @@ namespace tribo::app
       double        worst_overlap = 0, max_residual = 0;
       /// The law residual (dem/law_residual.h) over the steps, and the active set's work.
       double        max_law_residual = 0, sum_law_residual = 0, max_gap_violation = 0;
-      unsigned long total_factorizations = 0, fallbacks = 0;
+      unsigned long total_factorizations = 0, fallbacks = 0, gap_exceeded = 0;
 
       void add(const dem::StepReport &r)
       {
@@ -96,17 +96,18 @@ namespace tribo::app
         max_gap_violation = std::max(max_gap_violation, r.solver.gap_violation);
         total_factorizations += r.solver.factorizations;
         fallbacks += r.solver.fell_back ? 1 : 0;
+        gap_exceeded += r.solver.gap_exceeded ? 1 : 0;
         worst_overlap = std::max(worst_overlap, r.max_overlap);
       }
       void save(CheckpointOut &ar) const
       {
         ar << total_iterations << non_converged << max_iterations << worst_overlap << max_residual
-           << max_law_residual << sum_law_residual << max_gap_violation << total_factorizations << fallbacks;
+           << max_law_residual << sum_law_residual << max_gap_violation << total_factorizations << fallbacks << gap_exceeded;
       }
       void load(CheckpointIn &ar)
       {
         ar >> total_iterations >> non_converged >> max_iterations >> worst_overlap >> max_residual >>
-          max_law_residual >> sum_law_residual >> max_gap_violation >> total_factorizations >> fallbacks;
+          max_law_residual >> sum_law_residual >> max_gap_violation >> total_factorizations >> fallbacks >> gap_exceeded;
       }
     };
 
@@ -124,6 +125,7 @@ namespace tribo::app
         const double distance = p.law.detection_distance > 0 ? p.law.detection_distance : 0.1 * system.min_radius();
         dem::SolverParameters solver = p.solver;
         solver.gap_tolerance         = p.solver.relative_gap_tolerance * system.min_radius();
+        solver.gap_target            = p.solver.relative_gap_target * system.min_radius();
         mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
         scene->attach(*mj);
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
@@ -191,7 +193,15 @@ namespace tribo::app
               (prm.law.friction > 0 && !dem::solves_friction(method)) || r.solver.fell_back;
             std::ostringstream os;
             os << "warning: step " << step << " (t = " << time() << " s): ";
-            if (by_nlgs)
+            if (r.solver.gap_exceeded)
+              os << "a gap violation of " << r.solver.gap_violation / system.min_radius()
+                 << " of the smallest radius, above Solver/Gap target = " << prm.solver.relative_gap_target
+                 << ", at law residual " << r.solver.law_residual
+                 << ": a few large impulses (a body landing or stopped in one step) inflate the mean impulse "
+                    "the law residual is relative to, and hide closing velocities that drive discs through "
+                    "each other; tighten Solver/Residual target (or Solver/Tolerance with NLGS), use "
+                    "Solver/Method = interior-point, or let the body settle (a later Shear cell/Shear start)";
+            else if (by_nlgs)
               os << "NLGS did not converge in " << r.solver.iterations << " sweeps, residual " << r.solver.residual;
             else
               {
@@ -311,6 +321,7 @@ namespace tribo::app
         summary.set("solver_method", dem::method_name(method));
         summary.set("factorizations_mean", per_step(record.total_factorizations));
         summary.set("active_set_fallbacks", long(record.fallbacks));
+        summary.set("gap_target_exceeded", long(record.gap_exceeded));
         summary.set("max_overlap", record.worst_overlap);
         summary.set("max_overlap_over_min_radius", record.worst_overlap / system.min_radius());
         summary.set("n_bodies", long(system.bodies.size()));
@@ -342,6 +353,8 @@ namespace tribo::app
           os << ", " << per_step(record.total_factorizations) << " factorisations per step";
         if (method == dem::SolverParameters::Method::active_set)
           os << ", " << record.fallbacks << " NLGS fallbacks";
+        if (record.gap_exceeded > 0)
+          os << ", " << record.gap_exceeded << " steps above Solver/Gap target";
         if (timing.steps > 0)
           {
             const double n = timing.steps;

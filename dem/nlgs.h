@@ -124,6 +124,16 @@ namespace tribo::dem
     /// Solver/Gap tolerance as the case gives it: a fraction of the smallest radius (the run
     /// sets gap_tolerance = this times the smallest radius once the discs are known).
     double relative_gap_tolerance = 0;
+    /// Every method: the largest gap violation theta h max(0, -(u_n + shift)) over the IQS
+    /// contacts a step may keep and still count as converged, m (0: off). The law residual is
+    /// relative to the mean loaded impulse, which a few large impulses (a heavy body stopped
+    /// in one step) inflate: a step can pass it with closing velocities that drive discs
+    /// through each other. A step above gap_target is reported not converged
+    /// (SolveReport::gap_exceeded), and the run's log names the cause.
+    double gap_target = 0;
+    /// Solver/Gap target as the case gives it, a fraction of the smallest radius (the run sets
+    /// gap_target = this times the smallest radius).
+    double relative_gap_target = 0.01;
     /// The case subsection these controls were read from: messages name entries through it.
     ParameterSection section;
 
@@ -180,6 +190,9 @@ namespace tribo::dem
     /// (false: they shared a body and were solved serially, in the same order).
     bool concurrent = false;
     bool         converged  = true;
+    /// Whether the step's gap violation passed SolverParameters::gap_target (the step is then
+    /// not converged, whatever its law residual).
+    bool gap_exceeded = false;
     /// APGS with friction: blocks of sweeps whose map rose, after which the safeguard
     /// dropped the momentum (dem/apgs.h).
     unsigned int restarts = 0;

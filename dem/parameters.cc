@@ -127,6 +127,13 @@ namespace tribo::dem
                       "their passes over both cores, the same bits. Interior point: from 4000 "
                       "contacts its Newton matrix is factorised in two halves at once (its rounding "
                       "then differs from one thread's).");
+    prm.declare_entry("Gap target", "0.01", Double(),
+                      "Every method: the largest gap violation theta h max(0, -(u_n + shift)) an IQS "
+                      "step may keep and count as converged, as a fraction of the smallest radius "
+                      "(>= 0; 0: off). The law residual is relative to the mean impulse, which a few "
+                      "large impulses (a heavy body stopped in one step) inflate; a step above this "
+                      "target is not converged, the log says why, and summary.json counts it "
+                      "(gap_target_exceeded).");
     prm.declare_entry("Gap tolerance", "0", Double(),
                       "NLGS: extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
                       "0: off, the established code's norms only): every contact's gap violation "
@@ -168,6 +175,8 @@ namespace tribo::dem
                                  " (bands solved at once need the fixed order)");
     p.relative_gap_tolerance =
       f.get_checked(entry("Gap tolerance"), non_negative, "a fraction >= 0 of the smallest radius");
+    p.relative_gap_target =
+      f.get_checked(entry("Gap target"), non_negative, "a fraction >= 0 of the smallest radius");
     if (p.method != Method::nlgs)
       for (const char *name : {"Tolerance", "Norm", "Check interval", "Gap tolerance"})
         if (!f.is_default(entry(name)))

@@ -764,3 +764,45 @@ TEST(ContactSolvers, InteriorPointOnTwoThreadsGivesOneThreadsSolution)
       EXPECT_LT(r.law_residual, 1e-8);
     }
 }
+
+TEST(ContactSolvers, AStepAboveTheGapTargetIsNotConverged)
+{
+  // A heavy upper wall (10^4 times its mass) lands at 10 m/s on the stack: stopping it takes
+  // impulses that inflate the mean loaded impulse, so a law residual of 1e-3 relative to it
+  // still lets grains close on each other (the gap violation theta h max(0, -(u_n + b))).
+  // Above Solver/Gap target such a step is not converged; the converged solve stays below.
+  auto run = [](SolverParameters prm, std::vector<SolveReport> &reports) {
+    ParticleSystem s     = hexagonal_stack(0, 0);
+    RigidBody     &upper = s.bodies.back();
+    upper.mass *= 1e4;
+    upper.velocity = {0, -10};
+    prm.gap_target = 1e-3 * radius;
+    MoreauJean mj(0.5, ContactLaw{}, prm, 0.1 * radius);
+    for (int i = 0; i < 20; ++i)
+      reports.push_back(mj.step(s, h).solver);
+  };
+  SolverParameters apgs;
+  apgs.method          = SolverParameters::Method::apgs;
+  apgs.residual_target = 1e-3;
+  SolverParameters interior_point;
+  interior_point.method           = SolverParameters::Method::interior_point;
+  interior_point.residual_target  = 1e-8;
+  interior_point.predictor_sweeps = 0;
+  std::vector<SolveReport> loose, converged;
+  run(apgs, loose);
+  run(interior_point, converged);
+  unsigned int exceeded = 0;
+  for (const auto &r : loose)
+    {
+      EXPECT_LE(r.law_residual, 1.5e-3); // the relative residual is met, ...
+      EXPECT_EQ(r.gap_exceeded, r.gap_violation > 1e-3 * radius);
+      EXPECT_EQ(r.converged, !r.gap_exceeded); // ... the step is not converged when the gaps are not
+      exceeded += r.gap_exceeded ? 1 : 0;
+    }
+  EXPECT_GT(exceeded, 0u);
+  for (const auto &r : converged)
+    {
+      EXPECT_FALSE(r.gap_exceeded);
+      EXPECT_LT(r.gap_violation, 1e-3 * radius);
+    }
+}
