@@ -422,9 +422,9 @@ TEST(ContactSolvers, GlobalMethodsWithElasMatchConvergedNlgs)
         }
     }
   EXPECT_LE(fallbacks, 10u);
-  // MPRGP, APGD and the interior-point method: the compliance makes A better conditioned; they
-  // have no fallback and need none.
-  for (const SolverParameters &prm : {global_methods()[1], global_methods()[2], global_methods()[3]})
+  // MPRGP, the interior-point method, APGD and APGS: the compliance makes A better
+  // conditioned; they have no fallback and need none.
+  for (const SolverParameters &prm : {global_methods()[1], global_methods()[2], global_methods()[3], global_methods()[4]})
     {
       reports.clear();
       const Eigen::VectorXd v = velocities_after(s, law, prm, 30, &reports);
