@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """The shear cell of tests/cases/test_shear_physics.py (120 discs, 13 us of shear) solved by
-NLGS and by MPRGP stopped at the law residual NLGS reaches (docs/performance.md):
+NLGS and by a global method stopped at the law residual NLGS reaches (docs/performance.md):
+MPRGP and APGS frictionless, and APGS with Coulomb friction 0.3 (against NLGS with it):
 
-- MPRGP converges every step, to its target in the dense sheared layer (while the grains
+- the method converges every step, to its target in the dense sheared layer (while the grains
   rain down, a few lightly loaded contacts make the relative law residual meaningless);
 - the kinetic energy balance closes every step of the shear (KE_{i+1} - KE_i =
   h (P_ext + P_contacts); before it, the compaction's speed limit holds the upper wall);
@@ -47,27 +48,31 @@ def run(directory, *settings):
     return summary["results"] | {k: summary[k] for k in ("status", "solver_method")}, rows
 
 
-class MprgpAgainstNlgs(unittest.TestCase):
+class GlobalMethodAgainstNlgs:
+    """One global method (METHOD) against NLGS on the cell, both with Coulomb friction FRICTION."""
+    METHOD, FRICTION = None, 0.0
+
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
+        law = "Contact law/Friction coefficient=%g" % cls.FRICTION
         nlgs_dir = os.path.join(cls.tmp.name, "nlgs")
         os.makedirs(nlgs_dir)
-        cls.nlgs, nlgs_rows = run(nlgs_dir, "Solver/Method=nlgs")
+        cls.nlgs, nlgs_rows = run(nlgs_dir, "Solver/Method=nlgs", law)
         shear = [r["law_residual"] for r in nlgs_rows if r["time"] >= SHEAR_START]
         cls.target = float(np.mean(shear))
-        mprgp_dir = os.path.join(cls.tmp.name, "mprgp")
-        os.makedirs(mprgp_dir)
-        cls.mprgp, cls.rows = run(mprgp_dir, "Solver/Method=mprgp",
-                                  "Solver/Residual target=%.6g" % cls.target)
+        method_dir = os.path.join(cls.tmp.name, cls.METHOD)
+        os.makedirs(method_dir)
+        cls.method, cls.rows = run(method_dir, "Solver/Method=" + cls.METHOD,
+                                   "Solver/Residual target=%.6g" % cls.target, law)
 
     @classmethod
     def tearDownClass(cls):
         cls.tmp.cleanup()
 
     def test_every_step_reaches_the_target(self):
-        self.assertEqual(self.mprgp["solver_method"], "mprgp")
-        self.assertEqual(self.mprgp["status"], "complete")
+        self.assertEqual(self.method["solver_method"], self.METHOD)
+        self.assertEqual(self.method["status"], "complete")
         self.assertTrue(all(r["nlgs_converged"] == 1 for r in self.rows))
         # The target is relative to the warm start's mean impulse, the reported residual
         # to the final one's.
@@ -86,18 +91,37 @@ class MprgpAgainstNlgs(unittest.TestCase):
             self.assertLessEqual(abs(dke - rhs), 1e-6 * scale + 1e-30, "step %d" % b["step"])
 
     def test_load_and_friction_as_nlgs(self):
-        for s in (self.nlgs, self.mprgp):
+        for s in (self.nlgs, self.method):
             self.assertLess(abs(s["normal_force_mean"] / (P * L) - 1),
                             max(0.02, 3 * s["normal_force_stderr"] / (P * L)))
-        combined = np.hypot(self.nlgs["mu_stderr"], self.mprgp["mu_stderr"])
-        self.assertGreater(self.mprgp["mu_mean"], 0.02)
-        self.assertLess(abs(self.mprgp["mu_mean"] - self.nlgs["mu_mean"]), 3 * combined,
-                        "mu %.4f +/- %.4f (mprgp) against %.4f +/- %.4f (nlgs)" % (
-                            self.mprgp["mu_mean"], self.mprgp["mu_stderr"],
+        combined = np.hypot(self.nlgs["mu_stderr"], self.method["mu_stderr"])
+        self.assertGreater(self.method["mu_mean"], 0.02)
+        self.assertLess(abs(self.method["mu_mean"] - self.nlgs["mu_mean"]), 3 * combined,
+                        "mu %.4f +/- %.4f (%s) against %.4f +/- %.4f (nlgs)" % (
+                            self.method["mu_mean"], self.method["mu_stderr"], self.METHOD,
                             self.nlgs["mu_mean"], self.nlgs["mu_stderr"]))
 
     def test_power_balance(self):
-        self.assertLess(abs(self.mprgp["power_balance_ratio"] - 1), 0.05)
+        self.assertLess(abs(self.method["power_balance_ratio"] - 1), 0.05)
+
+
+class MprgpAgainstNlgs(GlobalMethodAgainstNlgs, unittest.TestCase):
+    METHOD = "mprgp"
+
+
+class ApgsAgainstNlgs(GlobalMethodAgainstNlgs, unittest.TestCase):
+    METHOD = "apgs"
+
+
+class FrictionalApgsAgainstNlgs(GlobalMethodAgainstNlgs, unittest.TestCase):
+    """Coulomb friction 0.3 between grains and at the walls: APGS solves it itself."""
+    METHOD, FRICTION = "apgs", 0.3
+
+    def test_friction_raises_mu(self):
+        # Friction between grains raises the layer's friction well above the frictionless
+        # cell's (about 0.1 on this cell, tests/cases/test_shear_physics.py).
+        self.assertGreater(self.nlgs["mu_mean"], 0.15)
+        self.assertGreater(self.method["mu_mean"], 0.15)
 
 
 if __name__ == "__main__":
