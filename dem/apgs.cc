@@ -340,7 +340,6 @@ namespace tribo::dem
               }
             else if (map > block_map)
               {
-                ++report.restarts;
                 t = 1;
                 z = y;
               }

@@ -193,9 +193,6 @@ namespace tribo::dem
     /// Whether the step's gap violation passed SolverParameters::gap_target (the step is then
     /// not converged, whatever its law residual).
     bool gap_exceeded = false;
-    /// APGS with friction: blocks of sweeps whose map rose, after which the safeguard
-    /// dropped the momentum (dem/apgs.h).
-    unsigned int restarts = 0;
     /// The achieved criterion: max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm
     /// ones) times tol, i.e. the relative quantity that is compared with tol.
     double residual = 0;

@@ -232,6 +232,9 @@ class MeaninglessValues(BadInputTestCase):
         self.check_entry("Solver/Residual target", "0", "a relative residual in (0, 1)")
         self.check_entry("Solver/Residual target", "2", "a relative residual in (0, 1)")
 
+    def test_negative_gap_target(self):
+        self.check_entry("Solver/Gap target", "-0.01", "a fraction >= 0 of the smallest radius")
+
     def test_unknown_solver_method(self):
         msg, where = self.run_bad_case(case({"Solver/Method": "cg"}))
         self.assert_at_line(msg, where["Solver/Method"])

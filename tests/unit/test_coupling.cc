@@ -118,6 +118,26 @@ namespace
       }
     return history;
   }
+
+  /// NLGS converged to 1e-12 (checked every sweep): the reference of the comparisons.
+  dem::SolverParameters converged_nlgs()
+  {
+    dem::SolverParameters nlgs;
+    nlgs.tolerance      = 1e-12;
+    nlgs.check_interval = 1;
+    nlgs.max_iterations = 100000;
+    return nlgs;
+  }
+
+  /// The largest absolute value of each quantity of @p history over its steps.
+  std::array<double, 4> largest_values(const BlockHistory &history)
+  {
+    std::array<double, 4> largest{};
+    for (const auto &row : history)
+      for (int k = 0; k < 4; ++k)
+        largest[k] = std::max(largest[k], std::abs(row[k]));
+    return largest;
+  }
 } // namespace
 
 TEST(Coupling, GlobalContactSolversMatchConvergedNlgsAgainstTheElasticBlock)
@@ -130,16 +150,10 @@ TEST(Coupling, GlobalContactSolversMatchConvergedNlgsAgainstTheElasticBlock)
   auto run = [](const dem::SolverParameters &prm, std::vector<dem::StepReport> &reports) {
     return elastic_block_history(prm, dem::ContactLaw{}, 60, reports);
   };
-  dem::SolverParameters nlgs;
-  nlgs.tolerance      = 1e-12;
-  nlgs.check_interval = 1;
-  nlgs.max_iterations = 100000;
+  const dem::SolverParameters  nlgs = converged_nlgs();
   std::vector<dem::StepReport> ignored;
   const BlockHistory           reference = run(nlgs, ignored);
-  std::array<double, 4>        scale{};
-  for (const auto &row : reference)
-    for (int k = 0; k < 4; ++k)
-      scale[k] = std::max(scale[k], std::abs(row[k]));
+  const std::array<double, 4>  scale     = largest_values(reference);
   ASSERT_GT(scale[1], 0.5 * P * L);
   ASSERT_GT(scale[2], 0.0);
   for (const auto method : {dem::SolverParameters::Method::active_set, dem::SolverParameters::Method::mprgp,
@@ -182,16 +196,10 @@ TEST(Coupling, FrictionalApgsMatchesConvergedNlgsAgainstTheElasticBlock)
     law.friction = 0.3;
     return elastic_block_history(prm, law, 20, reports);
   };
-  dem::SolverParameters nlgs;
-  nlgs.tolerance      = 1e-12;
-  nlgs.check_interval = 1;
-  nlgs.max_iterations = 100000;
+  const dem::SolverParameters  nlgs = converged_nlgs();
   std::vector<dem::StepReport> ignored;
   const BlockHistory           reference = run(nlgs, ignored);
-  std::array<double, 4>        scale{};
-  for (const auto &row : reference)
-    for (int k = 0; k < 4; ++k)
-      scale[k] = std::max(scale[k], std::abs(row[k]));
+  const std::array<double, 4>  scale     = largest_values(reference);
   ASSERT_GT(scale[0], 0.05 * P * L); // the friction at the sliding wall acts
   dem::SolverParameters prm = nlgs;
   prm.method                = dem::SolverParameters::Method::apgs;
