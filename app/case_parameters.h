@@ -6,7 +6,7 @@
 #include "core/parameter_file.h"
 #include "coupling/first_body.h"
 #include "dem/contact_law.h"
-#include "dem/nlgs.h"
+#include "dem/solvers/contact_solver.h"
 
 #include <deal.II/base/parameter_handler.h>
 

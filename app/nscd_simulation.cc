@@ -3,6 +3,7 @@
 #include "app/sample_file.h"
 #include "app/scene.h"
 #include "core/output.h"
+#include "dem/solvers/methods.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -28,15 +29,6 @@ namespace tribo::app
     }
 
     /// What SolveReport::iterations counts for @p method, as it follows a number.
-    const char *iteration_unit(dem::SolverParameters::Method method)
-    {
-      using Method = dem::SolverParameters::Method;
-      return method == Method::mprgp  ? " NLGS sweeps and MPRGP products"
-             : method == Method::apgd ? " NLGS sweeps and APGD products"
-             : method == Method::apgs ? " NLGS sweeps, APGS sweeps and products"
-                                      : " NLGS sweeps";
-    }
-
     /// Where the steps' wall time goes, over the steps of this process (since the start
     /// or the last resumption: not checkpointed), for summary.json "timing".
     struct StepTiming
@@ -68,11 +60,11 @@ namespace tribo::app
         j.set("step_mean_s", step / n);
         j.set("detection_mean_s", detection / n);
         j.set("boundary_body_mean_s", boundary_body / n);
-        j.set("nlgs_mean_s", solver / n);
+        j.set("solver_mean_s", solver / n);
         j.set("other_mean_s", (step - detection - boundary_body - solver) / n);
-        j.set("nlgs_sweeps_mean", double(sweeps) / n);
-        j.set("nlgs_check_passes_mean", double(check_passes) / n);
-        j.set("nlgs_ns_per_contact_update", contact_updates > 0 ? 1e9 * solver / contact_updates : 0.0);
+        j.set("solver_iterations_mean", double(sweeps) / n);
+        j.set("solver_check_passes_mean", double(check_passes) / n);
+        j.set("solver_ns_per_contact_update", contact_updates > 0 ? 1e9 * solver / contact_updates : 0.0);
         return j;
       }
     };
@@ -184,13 +176,11 @@ namespace tribo::app
         timing.add(r);
         if (!r.solver.converged && ++record.non_converged <= 10)
           {
-            // Which solve stopped short: NLGS (the method, the frictional steps of every
-            // method, the active set's fallback) with its own norm, or a global method at
-            // its law residual.
-            const auto method = prm.solver.method;
-            const bool by_nlgs =
-              method == dem::SolverParameters::Method::nlgs ||
-              (prm.law.friction > 0 && !dem::solves_friction(method)) || r.solver.fell_back;
+            // Which solve stopped short: NLGS (the method, the frictional steps it is handed,
+            // the active set's fallback) with its own norm, or a global method at its law
+            // residual.
+            const auto method  = prm.solver.method;
+            const bool by_nlgs = r.solver.solved_by_nlgs;
             std::ostringstream os;
             os << "warning: step " << step << " (t = " << time() << " s): ";
             if (r.solver.gap_exceeded)
@@ -212,15 +202,15 @@ namespace tribo::app
                   os << r.solver.factorizations << " factorisations"
                      << (r.solver.iterations > 0 ? " and " : "");
                 if (r.solver.iterations > 0 || r.solver.factorizations == 0)
-                  os << r.solver.iterations << iteration_unit(method);
+                  os << r.solver.iterations << " " << dem::solver_method(method).iterations;
               }
             os << (record.non_converged == 10 ? " (further warnings only counted)" : "");
             warn(os.str());
           }
         last = Row();
         last("n_contacts", r.n_contacts)("n_active_contacts", r.n_active)
-          ("nlgs_iterations", r.solver.iterations)("nlgs_residual", r.solver.residual)
-          ("nlgs_converged", r.solver.converged ? 1.0 : 0.0)("law_residual", r.solver.law_residual)
+          ("solver_iterations", r.solver.iterations)("solver_residual", r.solver.residual)
+          ("solver_converged", r.solver.converged ? 1.0 : 0.0)("law_residual", r.solver.law_residual)
           ("gap_violation", r.solver.gap_violation)("epsilon", r.epsilon)("max_overlap", r.max_overlap)
           ("kinetic_energy", r.kinetic_energy)("power_external", r.power_external)
           ("power_free", r.power_free)("power_contacts", r.power_contacts);
@@ -310,11 +300,11 @@ namespace tribo::app
         summary.set("time_step", h);
         summary.set("steps_planned", long(n_steps - start));
         summary.set("start_time", start * h);
-        summary.set("nlgs_iterations_total", long(record.total_iterations));
-        summary.set("nlgs_iterations_mean", per_step(record.total_iterations));
-        summary.set("nlgs_iterations_max", long(record.max_iterations));
-        summary.set("nlgs_residual_max", record.max_residual);
-        summary.set("nlgs_non_converged_steps", long(record.non_converged));
+        summary.set("solver_iterations_total", long(record.total_iterations));
+        summary.set("solver_iterations_mean", per_step(record.total_iterations));
+        summary.set("solver_iterations_max", long(record.max_iterations));
+        summary.set("solver_residual_max", record.max_residual);
+        summary.set("solver_non_converged_steps", long(record.non_converged));
         summary.set("law_residual_max", record.max_law_residual);
         summary.set("law_residual_mean", per_step(record.sum_law_residual));
         summary.set("gap_violation_max", record.max_gap_violation);
@@ -344,14 +334,12 @@ namespace tribo::app
 
         std::ostringstream os;
         os << steps_run << " steps in " << end.wall_time << " s, " << per_step(record.total_iterations)
-           << iteration_unit(method)
-           << " per step, " << record.non_converged << " steps not converged, law residual mean "
+           << " " << dem::solver_method(method).iterations << " per step, " << record.non_converged << " steps not converged, law residual mean "
            << per_step(record.sum_law_residual) << " max " << record.max_law_residual << ", worst overlap "
            << record.worst_overlap << " m";
-        if (method == dem::SolverParameters::Method::active_set ||
-            method == dem::SolverParameters::Method::interior_point)
+        if (record.total_factorizations > 0)
           os << ", " << per_step(record.total_factorizations) << " factorisations per step";
-        if (method == dem::SolverParameters::Method::active_set)
+        if (record.fallbacks > 0)
           os << ", " << record.fallbacks << " NLGS fallbacks";
         if (record.gap_exceeded > 0)
           os << ", " << record.gap_exceeded << " steps above Solver/Gap target";

@@ -54,14 +54,14 @@ try:
         t = s["timing"]
         contacts = sum(float(r["n_contacts"]) for r in rows) / len(rows)
         mu = sum(float(r["mu"]) for r in rows) / len(rows)
-        per_step, sweeps = t["step_mean_s"], t["nlgs_sweeps_mean"]
+        per_step, sweeps = t["step_mean_s"], t["solver_iterations_mean"]
         cost[model] = (per_step, per_step / sweeps)
         print(f"{model:5s}: steps {step0}-{step0 + t['steps']}: {per_step * 1e3:8.2f} ms per step "
-              f"(NLGS {t['nlgs_mean_s'] * 1e3:.2f}, detection {t['detection_mean_s'] * 1e3:.2f}, "
+              f"(NLGS {t['solver_mean_s'] * 1e3:.2f}, detection {t['detection_mean_s'] * 1e3:.2f}, "
               f"upper body {t['boundary_body_mean_s'] * 1e3:.2f}, other {t['other_mean_s'] * 1e3:.2f}), "
               f"{sweeps:7.1f} sweeps per step, {contacts:6.0f} contacts, "
               f"{per_step / sweeps * 1e6:7.1f} us per sweep, "
-              f"{t['nlgs_ns_per_contact_update']:5.1f} ns per contact update, mean mu {mu:.3f}")
+              f"{t['solver_ns_per_contact_update']:5.1f} ns per contact update, mean mu {mu:.3f}")
     print(f"fem overhead: {100 * (cost['fem'][0] / cost['rigid'][0] - 1):+.1f} % per step, "
           f"{100 * (cost['fem'][1] / cost['rigid'][1] - 1):+.1f} % per sweep")
 finally:

@@ -4,12 +4,17 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
 
 namespace tribo
 {
+  /// Checks for ParameterFile::get_checked(): finite and > 0, finite and >= 0.
+  inline bool is_positive(double v) { return v > 0 && std::isfinite(v); }
+  inline bool is_non_negative(double v) { return v >= 0 && std::isfinite(v); }
+
   /// Undo ParameterHandler's name mangling in its JSON and XML output ("_20" for a blank, ...).
   std::string demangle_parameter_name(const std::string &s);
 

@@ -1,6 +1,6 @@
 #include "dem/law_residual.h"
 
-#include "dem/nlgs.h"
+#include "dem/body_state.h"
 
 #include <algorithm>
 #include <cmath>

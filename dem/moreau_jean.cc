@@ -18,19 +18,7 @@ namespace tribo::dem
                          double detection_distance)
     : th(theta)
     , contact_law(law)
-    , solver(solver)
-    , active_set(solver)
-    , mprgp(solver)
-    , apgd(solver)
-    , apgs(solver)
-    , interior_point(solver)
-    , predictor([&] {
-      SolverParameters p = solver;
-      p.max_iterations   = std::max(1U, solver.predictor_sweeps);
-      p.check_interval   = p.max_iterations;
-      p.tolerance        = 1e-300; // never stops early
-      return p;
-    }())
+    , solver(make_contact_solver(solver))
     // The detection distance always covers the cohesion range.
     , distance(std::max(detection_distance, law.cohesion_range))
   {}
@@ -51,42 +39,21 @@ namespace tribo::dem
     }
   } // namespace
 
-  bool MoreauJean::global_method() const
+  void MoreauJean::assess_solve(double h, SolveReport &report) const
   {
-    const SolverParameters::Method method = solver.parameters().method;
-    return method != SolverParameters::Method::nlgs && (contact_law.friction <= 0 || solves_friction(method));
-  }
-
-  SolveReport MoreauJean::solve_contacts(double h)
-  {
-    if (!global_method())
-      return solver.solve(current, state, contact_law, th * h);
-    const SolverParameters &controls = solver.parameters();
-    unsigned int            sweeps   = 0;
-    if (controls.predictor_sweeps > 0)
-      sweeps = predictor.solve(current, state, contact_law, th * h).iterations;
-    if (controls.method != SolverParameters::Method::active_set)
+    const LawResidual       accuracy = law_residual(current, state, contact_law, th * h);
+    const SolverParameters &controls = solver->parameters();
+    if (controls.gap_target > 0 && accuracy.gap_violation > controls.gap_target)
       {
-        SolveReport report = controls.method == SolverParameters::Method::mprgp ? mprgp.solve(current, state, contact_law)
-                             : controls.method == SolverParameters::Method::apgd
-                               ? apgd.solve(current, state, contact_law)
-                             : controls.method == SolverParameters::Method::apgs
-                               ? apgs.solve(current, state, contact_law)
-                               : interior_point.solve(current, state, contact_law);
-        report.iterations += sweeps;
-        return report;
+        // Closing velocities that the relative law residual, over an inflated mean impulse,
+        // does not see: not converged, whatever the method's own test said.
+        report.gap_exceeded = true;
+        report.converged    = false;
       }
-    SolveReport        report         = active_set.solve(current, state, contact_law);
-    const unsigned int factorizations = report.factorizations;
-    if (!report.converged)
-      {
-        // Not found within its budget: NLGS from the predictor's impulses.
-        report           = solver.solve(current, state, contact_law, th * h);
-        report.fell_back = true;
-      }
-    report.factorizations = factorizations;
-    report.iterations += sweeps;
-    return report;
+    report.law_residual  = accuracy.relative;
+    report.gap_violation = accuracy.gap_violation;
+    if (!report.solved_by_nlgs)
+      report.residual = accuracy.relative;
   }
 
   StepReport MoreauJean::step(ParticleSystem &system, double h)
@@ -98,20 +65,9 @@ namespace tribo::dem
     set_up_local_problems(system, h, report);
 
     auto phase         = std::chrono::steady_clock::now();
-    report.solver      = solve_contacts(h);
+    report.solver      = solver->solve(current, state, contact_law, th * h);
     report.time_solver = seconds_since(phase);
-    const LawResidual accuracy   = law_residual(current, state, contact_law, th * h);
-    if (solver.parameters().gap_target > 0 && accuracy.gap_violation > solver.parameters().gap_target)
-      {
-        // Closing velocities that the relative law residual, over an inflated mean impulse,
-        // does not see: not converged, whatever the method's own test said.
-        report.solver.gap_exceeded = true;
-        report.solver.converged    = false;
-      }
-    report.solver.law_residual  = accuracy.relative;
-    report.solver.gap_violation = accuracy.gap_violation;
-    if (global_method() && !report.solver.fell_back)
-      report.solver.residual = accuracy.relative;
+    assess_solve(h, report.solver);
 
     const double deepest_overlap = measure_gaps(h, report);
     sum_contact_forces(h);
@@ -176,7 +132,7 @@ namespace tribo::dem
         disc_motion[d] = lookahead * h * Vec2(v.x() - v.z() * offset.y(), v.y() + v.z() * offset.x());
       }
     auto                 phase = std::chrono::steady_clock::now();
-    detector.detect(system, centres, distance, solver.parameters().threads, disc_motion, found);
+    detector.detect(system, centres, distance, solver->parameters().threads, disc_motion, found);
     report.time_detection      = seconds_since(phase);
 
     // The boundary body: free state, predicted nodes, half-disc contacts.
@@ -418,11 +374,11 @@ namespace tribo::dem
           for (unsigned int i = 0; i < boundary->n_nodes(); ++i)
             fastest_node = std::max(fastest_node, boundary->node_velocity(i).norm());
         const double speed = std::max(fastest.first, fastest_node);
-        const bool         by_nlgs = !global_method() || report.solver.fell_back;
+        const bool         by_nlgs = report.solver.solved_by_nlgs;
         std::ostringstream os;
         os << "an overlap of " << deepest_overlap << " m, more than the smallest disc radius ("
            << r_min << " m): contacts were missed or left unresolved ("
-           << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver.parameters().method) << " "
+           << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver->parameters().method) << " "
            << (report.solver.converged ? "converged" : "not converged") << "). ";
         if (speed * h > 0.25 * r_min)
           os << "The fastest mover, "
@@ -432,7 +388,7 @@ namespace tribo::dem
              << 0.25 * r_min / speed << " s keeps it within a quarter of the smallest radius";
         else
           {
-            const ParameterSection &solver_section = solver.parameters().section;
+            const ParameterSection &solver_section = solver->parameters().section;
             os << "No body moved more than a quarter of the smallest radius in the step: the "
                   "overlap does not come from the step size. Either discs were placed overlapping, "
                   "or the law lets it grow: with IQS, overlaps kept step after step within the "
@@ -478,7 +434,7 @@ namespace tribo::dem
     ar << n;
     for (const auto &[key, r] : impulses)
       ar << key << r.x() << r.y();
-    ar << solver.random_state();
+    ar << solver->random_state();
   }
 
   void MoreauJean::load(CheckpointIn &ar)
@@ -491,6 +447,6 @@ namespace tribo::dem
     previous_impulse.assign(impulses);
     std::string random;
     ar >> random;
-    solver.set_random_state(random);
+    solver->set_random_state(random);
   }
 } // namespace tribo::dem

@@ -3,25 +3,25 @@
 /// (Cao et al. 2011, eqs. 4-5; Jean 1999). Over a step [t_i, t_i + h]:
 /// - free velocity: v_free = v_i + h M^-1 F_ext (constant imposed loads);
 /// - detection at the predicted configuration q_pred = q_i + (1 - theta) h v_i;
-/// - local problems u = W r + u_free with W = H^T M^-1 H, solved by NLGS or the
-///   active-set method, MPRGP or the interior-point method (SolverParameters::method);
+/// - local problems u = W r + u_free with W = H^T M^-1 H, solved by the contact solver of
+///   SolverParameters::method (dem/solvers/contact_solver.h);
 /// - velocity v_{i+1} = v_free + M^-1 H r, position q_{i+1} = q_pred + theta h v_{i+1}.
 /// Imposed-velocity dofs keep their velocity. Impulses are warm-started from
 /// the previous step's contact between the same two discs.
 /// MoreauJean::step() runs these as named phases, in this order: predict(), detect(),
-/// set_up_local_problems(), solve_contacts() (and the law residual), measure_gaps(),
+/// set_up_local_problems(), the contact solve and assess_solve(), measure_gaps(),
 /// sum_contact_forces(), update_bodies(), update_boundary_body() (with a deformable body),
 /// compute_contact_powers(), check_overlaps().
 
-#include "dem/active_set.h"
-#include "dem/apgd.h"
-#include "dem/apgs.h"
+#include "dem/solvers/active_set.h"
+#include "dem/solvers/apgd.h"
+#include "dem/solvers/apgs.h"
 #include "dem/boundary.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
-#include "dem/interior_point.h"
-#include "dem/mprgp.h"
-#include "dem/nlgs.h"
+#include "dem/solvers/interior_point.h"
+#include "dem/solvers/mprgp.h"
+#include "dem/solvers/nlgs.h"
 #include "dem/particle_system.h"
 
 #include <Eigen/Core>
@@ -99,6 +99,8 @@ namespace tribo::dem
   class MoreauJean
   {
   public:
+    /// The scheme with @p theta, @p law and the contact solver of @p solver
+    /// (make_contact_solver()).
     MoreauJean(double theta, const ContactLaw &law, const SolverParameters &solver,
                double detection_distance);
 
@@ -124,6 +126,7 @@ namespace tribo::dem
     /// deformable body, less its impulse_extra_power()): -P_c is what contact c dissipates.
     const std::vector<double> &contact_power() const { return power_of_contact; }
     const ContactLaw &law() const { return contact_law; }
+    const SolverParameters &solver_parameters() const { return solver->parameters(); }
     double theta() const { return th; }
     double detection_distance() const { return distance; }
     /// Steps of motion at the start velocity over which a pair beyond the detection
@@ -138,12 +141,10 @@ namespace tribo::dem
     void load(CheckpointIn &ar);
 
   private:
-    /// Whether the step is solved by a global method: one is chosen, and the law is
-    /// frictionless or the method solves friction (APGS); otherwise NLGS solves it.
-    bool global_method() const;
-    /// The contact impulses of the current step by the chosen method (its predictor
-    /// sweeps included), updating state.
-    SolveReport solve_contacts(double h);
+    /// The law residual and gap violation of the solve that produced @p report (the residual
+    /// too, unless NLGS solved the step), and the step not converged above
+    /// SolverParameters::gap_target.
+    void assess_solve(double h, SolveReport &report) const;
 
     // The phases of step(), in order (see the file comment).
     /// Free velocities v_free = v + h M^-1 F_ext and the predicted configuration
@@ -173,13 +174,7 @@ namespace tribo::dem
 
     double                   th;
     ContactLaw               contact_law;
-    NlgsSolver               solver;
-    ActiveSetSolver          active_set;
-    MprgpSolver              mprgp;
-    ApgdSolver               apgd;
-    ApgsSolver               apgs;
-    InteriorPointSolver      interior_point;
-    NlgsSolver               predictor; ///< the active set's predictor sweeps
+    std::unique_ptr<ContactSolver> solver;
     double                   distance;
     ContactDetector          detector;
     std::vector<Contact>     found;   ///< detect()'s pairs, kept between steps with their capacity

@@ -87,7 +87,7 @@ def run(tribo, out, case, overrides):
         row["steps"] = f'{s.get("steps", "")} / {s.get("steps_planned", "")}'
         if "max_overlap_over_min_radius" in s:
             row["max_overlap_over_r"] = round(s["max_overlap_over_min_radius"], 3)
-        row["non_converged"] = s.get("nlgs_non_converged_steps", "")
+        row["non_converged"] = s.get("solver_non_converged_steps", "")
     stats = os.path.join(out, "statistics.csv")
     if os.path.exists(stats):
         with open(stats) as f:

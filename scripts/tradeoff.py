@@ -235,14 +235,14 @@ def main(directory):
                                            if math.isfinite(ratio_se) and ratio_se > 0 else float("nan"))
         out["power_balance_diff_over_se"] = diff_over_se(ratio, ratio_se, ref_results.get("power_balance_ratio"),
                                                          ref_results.get("power_balance_ratio_stderr"))
-        out["nlgs_sweeps_per_step"] = s.get("nlgs_iterations_mean")
+        out["solver_iterations_per_step"] = s.get("solver_iterations_mean")
         out["steady_state_reached"] = res.get("steady_state_reached")
 
     table = tabulate(cases, measure)
     ref_cost = table[0]["cost"]
 
     columns = ["knob", "value", "status", "cost", "cost_ratio", "mu_mean", "mu_error", "vx_l2",
-               "sigma_yy_l2", "sigma_xy_l2", "balance_residual", "nlgs_sweeps_per_step",
+               "sigma_yy_l2", "sigma_xy_l2", "balance_residual", "solver_iterations_per_step",
                "steady_state_reached", "directory",
                "mu_stderr", "mu_diff_over_se"]
     for q in COMPARED_STRESSES:
@@ -276,7 +276,7 @@ def main(directory):
                                      fmt_z(t.get("power_balance_diff_over_se", float("nan"))),
                                      fmt(t.get("balance_residual"), 2), fmt(t.get("vx_l2"), 2),
                                      fmt(t.get("sigma_yy_l2"), 2), fmt(t.get("sigma_xy_l2"), 2),
-                                     fmt(t.get("nlgs_sweeps_per_step"), 4),
+                                     fmt(t.get("solver_iterations_per_step"), 4),
                                      "-" if steady is None else ("yes" if steady else "**no**"),
                                      t["status"]]) + " |")
     hlines = ([(0, noise, "2 combined stderr (rung as noisy as the reference)")] if math.isfinite(noise) else [])

@@ -102,7 +102,7 @@ class ShearCell(unittest.TestCase):
         self.assertTrue(self.r["sliding"])
         self.assertTrue(self.r["steady_state_reached"])
         self.assertGreaterEqual(self.r["profile_samples_in_steady_state"], 100)
-        self.assertEqual(self.summary["nlgs_non_converged_steps"], 0)
+        self.assertEqual(self.summary["solver_non_converged_steps"], 0)
 
     def test_mean_normal_force_on_the_lower_wall_is_P_L(self):
         self.assertAlmostEqual(self.r["normal_force_target"], P * L, delta=1e-9 * P * L)

@@ -81,13 +81,13 @@ class RunOnce:
                                       "Statistics interval 1: one row per step")
         np.testing.assert_allclose(st["time"], st["step"] * s["time_step"], rtol=1e-12)
         self.assertAlmostEqual(s["simulated_time"], s["steps"] * s["time_step"], delta=1e-12 * s["simulated_time"])
-        self.assertEqual(s["nlgs_iterations_total"], int(st["nlgs_iterations"].sum()))
-        self.assertEqual(s["nlgs_iterations_max"], int(st["nlgs_iterations"].max()))
-        self.assertAlmostEqual(s["nlgs_iterations_mean"], st["nlgs_iterations"].mean(), places=9)
-        self.assertEqual(s["nlgs_non_converged_steps"], int((st["nlgs_converged"] == 0).sum()))
-        self.assertEqual(s["nlgs_residual_max"], st["nlgs_residual"].max())
+        self.assertEqual(s["solver_iterations_total"], int(st["solver_iterations"].sum()))
+        self.assertEqual(s["solver_iterations_max"], int(st["solver_iterations"].max()))
+        self.assertAlmostEqual(s["solver_iterations_mean"], st["solver_iterations"].mean(), places=9)
+        self.assertEqual(s["solver_non_converged_steps"], int((st["solver_converged"] == 0).sum()))
+        self.assertEqual(s["solver_residual_max"], st["solver_residual"].max())
         self.assertEqual(s["max_overlap"], st["max_overlap"].max())
-        self.assertTrue(set(np.unique(st["nlgs_converged"])) <= {0.0, 1.0})
+        self.assertTrue(set(np.unique(st["solver_converged"])) <= {0.0, 1.0})
         self.assertTrue(np.all(st["n_active_contacts"] <= st["n_contacts"]))
         self.assertTrue(np.all(st["max_overlap"] >= 0))
         self.assertGreater(s["wall_time"], 0)
@@ -915,9 +915,9 @@ class SolveStoppedShort(TempDirTestCase):
         with open(os.path.join(self.tmp, "out", "log.txt")) as f:
             warnings = [l for l in f.read().splitlines() if l.startswith("warning: step")]
         # Steps not converged: as many as the rows say, at most ten of them as lines.
-        n = int((st["nlgs_converged"] == 0).sum())
+        n = int((st["solver_converged"] == 0).sum())
         self.assertGreater(n, 0, "one factorisation / one sweep cannot solve every step")
-        self.assertEqual(s["nlgs_non_converged_steps"], n)
+        self.assertEqual(s["solver_non_converged_steps"], n)
         self.assertEqual(len(warnings), min(n, 10))
         if n >= 10:
             self.assertTrue(warnings[-1].endswith(" (further warnings only counted)"), warnings[-1])
@@ -934,7 +934,7 @@ class SolveStoppedShort(TempDirTestCase):
                          r"( \(further warnings only counted\))?$", line)
             self.assertTrue(m, line)
             row = list(st["step"]).index(int(m.group(1)))
-            self.assertEqual(st["nlgs_converged"][row], 0)
+            self.assertEqual(st["solver_converged"][row], 0)
             self.assertAlmostEqual(float(m.group(3)) / st["law_residual"][row], 1, delta=1e-5)
             self.assertGreater(float(m.group(3)), 1e-3)
 
@@ -946,7 +946,7 @@ class SolveStoppedShort(TempDirTestCase):
                          r"( \(further warnings only counted\))?$", line)
             self.assertTrue(m, line)
             row = list(st["step"]).index(int(m.group(1)))
-            self.assertAlmostEqual(float(m.group(3)) / st["nlgs_residual"][row], 1, delta=1e-5)
+            self.assertAlmostEqual(float(m.group(3)) / st["solver_residual"][row], 1, delta=1e-5)
 
 
 class FailedRun(TempDirTestCase):

@@ -61,7 +61,7 @@ class Resume(TempDirTestCase):
         sa, sb = read_json(os.path.join(a, "summary.json")), read_json(os.path.join(b, "summary.json"))
         self.assertEqual(sb["status"], "complete")
         self.assertEqual(sa["results"], sb["results"])
-        for key in ("steps", "nlgs_iterations_total", "nlgs_iterations_max", "max_overlap",
+        for key in ("steps", "solver_iterations_total", "solver_iterations_max", "max_overlap",
                     "n_field_snapshots"):
             self.assertEqual(sa[key], sb[key], key)
         with h5py.File(os.path.join(a, "results.h5"), "r") as fa, \

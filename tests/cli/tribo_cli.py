@@ -38,8 +38,8 @@ OUTPUTS_MD = os.path.normpath(
 
 #: Columns every statistics.csv starts with, in this order (docs/outputs.md).
 COMMON_COLUMNS = [
-    "time", "step", "n_contacts", "n_active_contacts", "nlgs_iterations", "nlgs_residual",
-    "nlgs_converged", "law_residual", "gap_violation", "epsilon", "max_overlap", "kinetic_energy", "power_external",
+    "time", "step", "n_contacts", "n_active_contacts", "solver_iterations", "solver_residual",
+    "solver_converged", "law_residual", "gap_violation", "epsilon", "max_overlap", "kinetic_energy", "power_external",
     "power_free", "power_contacts"]
 #: Columns added by each scene, in this order.
 SCENE_COLUMNS = {

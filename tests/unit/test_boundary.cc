@@ -326,6 +326,7 @@ TEST(HalfDiscs, ImpactOnALumpedChainConservesMomentum)
   const unsigned g = s.add_disc({3.5 * l, y_face - 0.5 * l - r - 1e-9}, r, rho);
   s.bodies[g].velocity = {0.3, 2.0};
   SolverParameters prm;
+  prm.method         = SolverParameters::Method::nlgs;
   prm.tolerance      = 1e-10;
   prm.check_interval = 1;
   MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);
@@ -364,6 +365,7 @@ TEST(HalfDiscs, EnergyBalanceWithABoundaryBodyClosesEveryStep)
     s.add_disc({(i % 8 + 0.5 + 0.3 * (i / 8 % 2)) * l, (1.05 + 1.05 * (i / 8)) * l}, 0.5e-6, rho);
   LumpedChain chain(8, L, 4.0 * l, 2e-8, {0, -100.0});
   SolverParameters prm;
+  prm.method         = SolverParameters::Method::nlgs;
   prm.tolerance = 1e-9;
   prm.check_interval = 1;
   MoreauJean mj(0.5, ContactLaw{}, prm, 5e-8);

@@ -1,9 +1,9 @@
 // The sparse Delassus operator, the law residual and the active-set method against
 // the dense operator, closed forms and NLGS converged to 1e-12.
-#include "dem/apgs.h"
-#include "dem/bisected_cholesky.h"
-#include "dem/delassus.h"
-#include "dem/frictionless_problem.h"
+#include "dem/solvers/apgs.h"
+#include "dem/solvers/bisected_cholesky.h"
+#include "dem/solvers/delassus.h"
+#include "dem/solvers/frictionless_problem.h"
 #include "dem/law_residual.h"
 #include "dem/moreau_jean.h"
 
@@ -52,6 +52,7 @@ namespace
   SolverParameters nlgs_converged()
   {
     SolverParameters p;
+    p.method         = SolverParameters::Method::nlgs;
     p.tolerance      = 1e-12;
     p.check_interval = 1;
     p.max_iterations = 200000;
@@ -195,7 +196,7 @@ TEST(ContactSolvers, GlobalMethodsWithTheWallAsLowRankMatchConvergedNlgs)
 {
   // 36 columns: the upper wall carries more than 64 contacts, so the interior-point
   // method solves through Sherman-Morrison-Woodbury and MPRGP multiplies by
-  // A_sparse + U U^T (dem/delassus.h).
+  // A_sparse + U U^T (dem/solvers/delassus.h).
   const ParticleSystem s = hexagonal_stack(3600, 2, 36);
   {
     ParticleSystem probe = s;
@@ -265,7 +266,7 @@ TEST(ContactSolvers, ApgsPolishesOneWrongContactWithoutAWholeSweep)
   // A converged wide stack (300 columns, about 2700 contacts) with the impulse of its most
   // loaded contact removed: the contacts above the target are that one and its bodies'
   // other contacts, far fewer than ApgsSolver::polish_fraction of all, so the local polish
-  // (dem/apgs.h) restores the solution to the target before any block of
+  // (dem/solvers/apgs.h) restores the solution to the target before any block of
   // ApgsSolver::check_interval sweeps (without it: one check, 10 sweeps, one check at least).
   ParticleSystem   s = hexagonal_stack(30000, 0, 300);
   const ContactLaw law;
@@ -298,6 +299,7 @@ TEST(ContactSolvers, ApgsPolishesOneWrongContactWithoutAWholeSweep)
   SolverParameters prm;
   prm.method          = SolverParameters::Method::apgs;
   prm.residual_target = 1e-3; // the shipped cases' accuracy (tighter, the local passes converge slowly)
+  prm.predictor_sweeps = 0;
   ApgsSolver        apgs(prm);
   const SolveReport report = apgs.solve(contacts, state, law);
   EXPECT_TRUE(report.converged);
@@ -444,7 +446,9 @@ TEST(ContactSolvers, GlobalMethodsWithoutAFrictionalSolveUseNlgs)
         continue;
       std::vector<SolveReport> reports;
       const Eigen::VectorXd v     = velocities_after(hexagonal_stack(400, 2), law, prm, 5, &reports);
-      const Eigen::VectorXd v_ref = velocities_after(hexagonal_stack(400, 2), law, SolverParameters{}, 5);
+      SolverParameters      nlgs  = prm;
+      nlgs.method                 = SolverParameters::Method::nlgs;
+      const Eigen::VectorXd v_ref = velocities_after(hexagonal_stack(400, 2), law, nlgs, 5);
       EXPECT_EQ(v, v_ref) << method_name(prm.method);
       for (const auto &r : reports)
         {
@@ -456,7 +460,7 @@ TEST(ContactSolvers, GlobalMethodsWithoutAFrictionalSolveUseNlgs)
 
 namespace
 {
-  /// APGS to a law residual of 1e-8 (the frictional sweeps' floor is near 1e-9, dem/apgs.h).
+  /// APGS to a law residual of 1e-8 (the frictional sweeps' floor is near 1e-9, dem/solvers/apgs.h).
   SolverParameters frictional_apgs()
   {
     SolverParameters apgs;
@@ -655,7 +659,7 @@ TEST(ContactSolvers, LawResidualsFrictionTermMatchesClosedForms)
 TEST(ContactSolvers, InteriorPointReachesATightTargetAtEveryWarmStartedStepOfAHyperstaticStack)
 {
   // Each warm-started step ends at the target, whether the iteration gets there or the
-  // crossover closes the closed set exactly (dem/interior_point.cc), and the velocities
+  // crossover closes the closed set exactly (dem/solvers/interior_point.cc), and the velocities
   // are converged NLGS's: a crossover that froze a growing component along the redundant
   // directions would break both within a few steps.
   SolverParameters prm;

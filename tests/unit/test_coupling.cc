@@ -63,6 +63,7 @@ TEST(Coupling, ElasticBlockOnGrainsCarriesThePressureAndBalancesEnergy)
   fem::ElasticBody       body(col.prm);
   coupling::ElasticBoundary boundary(body);
   dem::SolverParameters    nlgs;
+  nlgs.method    = dem::SolverParameters::Method::nlgs;
   nlgs.tolerance = 1e-8;
   nlgs.check_interval = 1;
   dem::MoreauJean mj(0.5, dem::ContactLaw{}, nlgs, 0.05 * l);
@@ -123,6 +124,7 @@ namespace
   dem::SolverParameters converged_nlgs()
   {
     dem::SolverParameters nlgs;
+    nlgs.method         = dem::SolverParameters::Method::nlgs;
     nlgs.tolerance      = 1e-12;
     nlgs.check_interval = 1;
     nlgs.max_iterations = 100000;
@@ -357,6 +359,7 @@ TEST(Coupling, GrainsSlidingUnderAShiftedFaceAreNeverLost)
       fem::ElasticBody    body(prm);
       ShiftedBoundary     boundary(body);
       dem::SolverParameters nlgs;
+      nlgs.method         = dem::SolverParameters::Method::nlgs;
       nlgs.tolerance      = 1e-6;
       nlgs.check_interval = 1;
       const double    distance = 0.05 * l;

@@ -1,6 +1,6 @@
 // The own Delassus block of a contact and the exchange of impulses through
 // body velocities, against a dense W = H^T M^-1 H.
-#include "dem/nlgs.h"
+#include "dem/solvers/nlgs.h"
 #include "dem/moreau_jean.h"
 
 #include <Eigen/Dense>

@@ -13,9 +13,11 @@ namespace
 {
   const double rho = 7800, r = 0.6e-6;
 
+  /// NLGS at a tight tolerance, checked every sweep.
   SolverParameters tight()
   {
     SolverParameters p;
+    p.method         = SolverParameters::Method::nlgs;
     p.tolerance      = 1e-6;
     p.check_interval = 1;
     return p;

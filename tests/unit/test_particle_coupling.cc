@@ -89,6 +89,7 @@ namespace
     auto body = coupling::make_first_body(column_body(model, h, y_grain + s));
 
     dem::SolverParameters nlgs;
+    nlgs.method    = dem::SolverParameters::Method::nlgs;
     nlgs.tolerance = tolerance;
     nlgs.check_interval = 1;
     dem::MoreauJean mj(0.5, dem::ContactLaw{}, nlgs, 0.05 * s);

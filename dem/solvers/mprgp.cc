@@ -1,6 +1,6 @@
-#include "dem/mprgp.h"
+#include "dem/solvers/mprgp.h"
 
-#include "dem/scaled_operator.h"
+#include "dem/solvers/scaled_operator.h"
 
 #include <algorithm>
 #include <cmath>

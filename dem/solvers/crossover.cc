@@ -1,4 +1,4 @@
-#include "dem/crossover.h"
+#include "dem/solvers/crossover.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file MPRGP, the modified proportioning with reduced gradient projections of Dostál
-/// and Schöberl (2005), on the frictionless contact problem (dem/frictionless_problem.h):
+/// and Schöberl (2005), on the frictionless contact problem (dem/solvers/frictionless_problem.h):
 /// a conjugate-gradient method for the bound-constrained quadratic problem
 ///     min f(x) = x.A x / 2 + b.x  over x >= 0,
 /// that needs no ordering of the contacts, only products with the sparse Delassus
@@ -9,7 +9,7 @@
 /// Preconditioning by the diagonal D of A, as a change of variables y = D^(1/2) x:
 /// the problem in y has A' = D^(-1/2) A D^(-1/2) (unit diagonal), b' = D^(-1/2) b and the
 /// same bounds y >= 0; the gradient is g = A' y + b' = D^(-1/2) w. The walls (bodies with
-/// more than LowRankBodies::contact_limit contacts, dem/delassus.h) are kept out of the
+/// more than LowRankBodies::contact_limit contacts, dem/solvers/delassus.h) are kept out of the
 /// sparse matrix as low-rank columns, A' = A'_sparse + U'U'^T: a product then costs
 /// O(nnz(A'_sparse) + n k) (k: the walls' free dofs) instead of a dense block per wall.
 /// With F = {i : y_i > 0} (free) and the others active, the free gradient phi_i = g_i on
@@ -32,18 +32,17 @@
 /// about the cost of one NLGS sweep); it then keeps its last iterate, which satisfies
 /// x >= 0, and reports not converged.
 
-#include "dem/frictionless_solver.h"
+#include "dem/solvers/global_solver.h"
 
 namespace tribo::dem
 {
-  class MprgpSolver : public FrictionlessSolver
+  class MprgpSolver : public GlobalSolver
   {
   public:
-    using FrictionlessSolver::FrictionlessSolver;
+    using GlobalSolver::GlobalSolver;
+
+  protected:
     /// The report's iterations are the products with the Delassus operator.
     SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &) override;
-
-  private:
-    const char *name() const override { return "MPRGP"; }
   };
 } // namespace tribo::dem

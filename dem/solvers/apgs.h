@@ -1,10 +1,10 @@
 #pragma once
 /// @file APGS, the accelerated projected Gauss-Seidel method, on the frictionless contact
-/// problem (dem/frictionless_problem.h): min f(x) = x.A x / 2 + b.x over x >= 0, and on
-/// the problem with Coulomb friction (dem/sweep_problem.h), whose sweeps solve each
+/// problem (dem/solvers/frictionless_problem.h): min f(x) = x.A x / 2 + b.x over x >= 0, and on
+/// the problem with Coulomb friction (dem/solvers/sweep_problem.h), whose sweeps solve each
 /// contact's 2x2 law exactly (ContactLaw::solve_coulomb()).
 ///
-/// In the scaled variables of APGD (dem/apgd.h: y = D^(1/2) x, the operator A' + U'U'^T
+/// In the scaled variables of APGD (dem/solvers/apgd.h: y = D^(1/2) x, the operator A' + U'U'^T
 /// with unit diagonal, b' = D^(-1/2) b, g = A'y + b'), one projected Gauss-Seidel sweep
 /// S(v) visits the contacts in order and sets v_j = max(0, v_j - g_j(v)) with v already
 /// updated before j (one pass over the operator, the walls' low-rank part kept current in
@@ -58,17 +58,18 @@
 /// 64 000 grains, 0.67-0.94 at 1e-3; on two threads, with the polish, 0.75 times at 4000
 /// grains and 0.96 at 16 000 at 1e-3).
 
-#include "dem/frictionless_solver.h"
+#include "dem/solvers/global_solver.h"
 
 namespace tribo::dem
 {
-  class ApgsSolver : public FrictionlessSolver
+  class ApgsSolver : public GlobalSolver
   {
   public:
-    using FrictionlessSolver::FrictionlessSolver;
+    using GlobalSolver::GlobalSolver;
+    bool solves_friction() const override { return true; }
     /// Sweeps between natural-map checks.
     static constexpr unsigned int check_interval = 10;
-    /// Slabs of consecutive contacts of a sweep (dem/apgs.cc): even ones, then odd ones.
+    /// Slabs of consecutive contacts of a sweep (dem/solvers/apgs.cc): even ones, then odd ones.
     static constexpr long slab_count = 8;
     /// The local polish after a check that fails: passes over the contacts above the target
     /// and their neighbours, ...
@@ -84,13 +85,11 @@ namespace tribo::dem
     static constexpr unsigned int max_polishes = 1024;
     /// ... and only while those contacts are at most this fraction of all.
     static constexpr double polish_fraction = 0.05;
+
+  protected:
     /// The report's iterations are the sweeps plus the whole checks (one product each); the
     /// polishes and their checks of the polished rows are not counted.
     SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state,
                               const ContactLaw &law) override;
-
-  private:
-    bool        solves_friction() const override { return true; }
-    const char *name() const override { return "APGS"; }
   };
 } // namespace tribo::dem

@@ -1,11 +1,11 @@
 #pragma once
 /// @file The frictionless contact problem of a step as a linear complementarity problem,
-/// shared by the global solvers (dem/active_set.h, dem/mprgp.h).
+/// shared by the global solvers (dem/solvers/active_set.h, dem/solvers/mprgp.h).
 ///
 /// With x = r~ = r_n + gamma h the shifted normal impulses (N s/m) and
 ///     w = A x + b,  A = W_nn + C,  b = u_free,n + shift - W_nn (gamma h)
 /// the law's normal velocities (m/s; W_nn the normal part of the sparse Delassus operator,
-/// dem/delassus.h; C the diagonal ELAS compliances 1/(theta k h^2), 0 for IQS; shift the
+/// dem/solvers/delassus.h; C the diagonal ELAS compliances 1/(theta k h^2), 0 for IQS; shift the
 /// law's gap term, dem/contact_law.h), both IQS and ELAS are
 ///     0 <= x  _|_  w >= 0,
 /// i.e. the minimum over x >= 0 of the contact energy f(x) = x.A x / 2 + b.x, whose
@@ -32,7 +32,7 @@ namespace tribo::dem
     /// The problem of @p contacts against @p state, whose velocities must already hold the
     /// contacts' warm-start impulses c.r; x starts at max(0, r_n + gamma h). With
     /// @p low_rank_bodies, the bodies with many contacts (walls) are kept out of A as the
-    /// columns U (dem/delassus.h): the operator is A + U U^T.
+    /// columns U (dem/solvers/delassus.h): the operator is A + U U^T.
     FrictionlessProblem(const std::vector<Contact> &contacts, const BodyState &state,
                         bool low_rank_bodies = false);
 
@@ -83,8 +83,4 @@ namespace tribo::dem
     /// the change to @p state's velocities.
     void apply(const Eigen::VectorXd &y, std::vector<Contact> &contacts, BodyState &state) const;
   };
-
-
-  /// Throws RunError naming @p method unless @p law is frictionless.
-  void require_frictionless(const ContactLaw &law, const std::string &method);
 } // namespace tribo::dem

@@ -1,9 +1,7 @@
-#include "dem/frictionless_problem.h"
-#include "dem/frictionless_solver.h"
+#include "dem/solvers/frictionless_problem.h"
 
-#include "core/errors.h"
-#include "dem/delassus.h"
-#include "dem/nlgs.h"
+#include "dem/body_state.h"
+#include "dem/solvers/delassus.h"
 
 #include <algorithm>
 #include <cmath>
@@ -81,22 +79,6 @@ namespace tribo::dem
     p.b = b.cwiseProduct(p.inv_root);
     p.y = x.cwiseQuotient(p.inv_root);
     return p;
-  }
-
-  SolveReport FrictionlessSolver::solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law)
-  {
-    if (contacts.empty())
-      return {};
-    if (!solves_friction())
-      require_frictionless(law, name());
-    return solve_problem(contacts, state, law);
-  }
-
-  void require_frictionless(const ContactLaw &law, const std::string &method)
-  {
-    if (law.friction > 0)
-      throw RunError("the " + method + " method solves frictionless problems only (Coulomb "
-                     "friction mu = " + std::to_string(law.friction) + ")");
   }
 
   void FrictionlessProblem::apply(const Eigen::VectorXd &y, std::vector<Contact> &contacts,

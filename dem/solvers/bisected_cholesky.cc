@@ -1,7 +1,7 @@
-#include "dem/bisected_cholesky.h"
+#include "dem/solvers/bisected_cholesky.h"
 
-#include "dem/delassus.h"
-#include "dem/nlgs.h"
+#include "dem/solvers/delassus.h"
+#include "dem/body_state.h"
 
 #include <deal.II/base/parallel.h>
 

@@ -1,4 +1,4 @@
-#include "dem/scaled_operator.h"
+#include "dem/solvers/scaled_operator.h"
 
 #include <cmath>
 

@@ -39,7 +39,7 @@ namespace tribo::dem
   struct Contact;
   struct BodyState;
 
-  /// The rows of a frictionless problem of @p contacts (dem/frictionless_problem.h, walls as
+  /// The rows of a frictionless problem of @p contacts (dem/solvers/frictionless_problem.h, walls as
   /// low-rank columns) split in two: METIS cuts the graph of the bodies that couple contacts
   /// in A' (bodies with a free dof and at most LowRankBodies::contact_limit contacts; an edge
   /// per contact, a body weighted by its contacts) into two halves of about as many

@@ -1,7 +1,7 @@
-#include "dem/apgs.h"
+#include "dem/solvers/apgs.h"
 
-#include "dem/scaled_operator.h"
-#include "dem/sweep_problem.h"
+#include "dem/solvers/scaled_operator.h"
+#include "dem/solvers/sweep_problem.h"
 
 #include <deal.II/base/parallel.h>
 
@@ -83,7 +83,7 @@ namespace tribo::dem
     // map is kept in `error` and the mean in `mean_loaded` (N s/m).
     Eigen::VectorXd error(n);
     double          mean_loaded = problem.scale;
-    // Over fixed chunks (dem/scaled_operator.h), concurrently with Threads > 1, merged in
+    // Over fixed chunks (dem/solvers/scaled_operator.h), concurrently with Threads > 1, merged in
     // chunk order: the same bits on any number of threads. The chunks' sums are kept, so
     // that the check after a polish recomputes only the chunks that hold a changed row.
     struct MapSums

@@ -1,10 +1,10 @@
 #pragma once
 /// @file APGD, the accelerated projected gradient method (Nesterov's momentum with the
 /// projection of FISTA, Beck and Teboulle 2009, and the adaptive restart of O'Donoghue and
-/// Candès 2015), on the frictionless contact problem (dem/frictionless_problem.h):
+/// Candès 2015), on the frictionless contact problem (dem/solvers/frictionless_problem.h):
 ///     min f(x) = x.A x / 2 + b.x  over x >= 0.
 ///
-/// It works in the diagonally scaled variables of MPRGP (dem/mprgp.h): y = D^(1/2) x,
+/// It works in the diagonally scaled variables of MPRGP (dem/solvers/mprgp.h): y = D^(1/2) x,
 /// A' = D^(-1/2) A D^(-1/2) (unit diagonal, the walls as the low-rank columns U', so
 /// A' + U'U'^T), b' = D^(-1/2) b, gradient g = A'y + b'. From the warm start y_0 = z_0,
 /// t_0 = 1, each iteration is one product with the operator:
@@ -21,7 +21,7 @@
 /// close in bulk, and its iterations follow the square root of the operator's condition
 /// number (MPRGP's expansion steps degenerate into fixed-step gradient steps in steady
 /// shear, docs/performance.md). The products and sums run over fixed chunks of the
-/// contacts (dem/scaled_operator.h): the same bits on any number of threads.
+/// contacts (dem/solvers/scaled_operator.h): the same bits on any number of threads.
 ///
 /// It stops when the natural map max_i |min(x_i, w_i / A_ii)| = max_i |min(y_i, g_i)| /
 /// sqrt(D_i) (the law residual's measure, dem/law_residual.h, at the iterate y_k, known
@@ -30,18 +30,17 @@
 /// (the power iterations counted); it then keeps its last iterate, x >= 0, and reports not
 /// converged.
 
-#include "dem/frictionless_solver.h"
+#include "dem/solvers/global_solver.h"
 
 namespace tribo::dem
 {
-  class ApgdSolver : public FrictionlessSolver
+  class ApgdSolver : public GlobalSolver
   {
   public:
-    using FrictionlessSolver::FrictionlessSolver;
+    using GlobalSolver::GlobalSolver;
+
+  protected:
     /// The report's iterations are the products with the Delassus operator.
     SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &) override;
-
-  private:
-    const char *name() const override { return "APGD"; }
   };
 } // namespace tribo::dem

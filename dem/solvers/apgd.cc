@@ -1,6 +1,6 @@
-#include "dem/apgd.h"
+#include "dem/solvers/apgd.h"
 
-#include "dem/scaled_operator.h"
+#include "dem/solvers/scaled_operator.h"
 
 #include <algorithm>
 #include <cmath>

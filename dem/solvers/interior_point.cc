@@ -1,6 +1,6 @@
-#include "dem/interior_point.h"
+#include "dem/solvers/interior_point.h"
 
-#include "dem/crossover.h"
+#include "dem/solvers/crossover.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +20,7 @@ namespace tribo::dem
     /// sample, the same steps at the round-off floor).
     constexpr double refine_below = 1e-5;
 
-    /// The crossover (dem/crossover.h): tried once the natural map is below this fraction
+    /// The crossover (dem/solvers/crossover.h): tried once the natural map is below this fraction
     /// of the mean impulse ...
     constexpr double crossover_below = 1e-4;
     /// ... and the closed set changed by at most this many contacts in the last iteration;
@@ -44,12 +44,12 @@ namespace tribo::dem
     SolveReport report;
     const FrictionlessProblem lcp(contacts, state, true);
     const Eigen::Index        n = lcp.size();
-    // The scaled problem (dem/mprgp.h).
+    // The scaled problem (dem/solvers/mprgp.h).
     FrictionlessProblem::Scaled       scaled   = lcp.scaled();
     const Eigen::VectorXd            &inv_root = scaled.inv_root;
     const Eigen::VectorXd            &b        = scaled.b;
     Eigen::VectorXd                  &y        = scaled.y;
-    // The operator A' + U U^T (the walls as low-rank columns, dem/delassus.h).
+    // The operator A' + U U^T (the walls as low-rank columns, dem/solvers/delassus.h).
     auto product = [&](const Eigen::VectorXd &v) { return scaled.product(v); };
     // The scale of y: the warm start's loaded impulses, or the free velocities' (A'y = -b'
     // at a solution with unit diagonal), whichever is larger: a warm start of tiny

@@ -1,11 +1,11 @@
 #pragma once
-/// @file The matrix-free pieces shared by the first-order global methods (dem/mprgp.h,
-/// dem/apgd.h): the scaled Delassus operator A' + U'U'^T of a FrictionlessProblem::Scaled
+/// @file The matrix-free pieces shared by the first-order global methods (dem/solvers/mprgp.h,
+/// dem/solvers/apgd.h): the scaled Delassus operator A' + U'U'^T of a FrictionlessProblem::Scaled
 /// applied one row at a time, and passes over fixed chunks of the contacts whose partial
 /// results are merged in chunk order, so that every product and sum gives the same bits
 /// on any number of threads (SolverParameters::threads).
 
-#include "dem/frictionless_problem.h"
+#include "dem/solvers/frictionless_problem.h"
 
 #include <deal.II/base/parallel.h>
 
@@ -65,7 +65,7 @@ namespace tribo::dem
 
   /// The operator A' + U'U'^T of a scaled frictionless problem (dimensionless: A' has a unit
   /// diagonal), row by row. A' is symmetric, so its column j, stored, is its row j; U' (n x k,
-  /// the walls' low-rank columns, dem/delassus.h) is kept by rows so that its part of a
+  /// the walls' low-rank columns, dem/solvers/delassus.h) is kept by rows so that its part of a
   /// product costs O(wall contacts), not O(n k).
   class ScaledOperator
   {
@@ -79,7 +79,7 @@ namespace tribo::dem
     /// Prepare the row products with @p v (computes U'^T v); call before row_times(v, .).
     void set_vector(const Eigen::VectorXd &v);
     /// After v_j changed by @p change in place: keep U'^T v current (Gauss-Seidel sweeps,
-    /// dem/apgs.h), O(the row's low-rank entries).
+    /// dem/solvers/apgs.h), O(the row's low-rank entries).
     void add_to_low_rank(Eigen::Index j, double change)
     {
       for (Eigen::Index q = low_rank_start[j]; q < low_rank_start[j + 1]; ++q)

@@ -1,7 +1,7 @@
-#include "dem/delassus.h"
+#include "dem/solvers/delassus.h"
 
 #include "dem/contact.h"
-#include "dem/nlgs.h"
+#include "dem/body_state.h"
 
 #include <Eigen/Dense>
 

@@ -1,47 +1,36 @@
 #pragma once
-/// @file Nonlinear Gauss-Seidel on the Delassus operator, in the
-/// "exchange local/global" form: body velocities are kept up to date and each
-/// local solve reads its contact's velocity from them (no off-diagonal W stored).
-///
-/// Convergence is checked every `check_interval` sweeps with the norms of the
-/// established NSCD code (LMGC90, see ../shared/notes/nscd-reference.md), in a check
-/// pass that solves every contact's local problem against the current state and applies
-/// nothing, over the N contacts with a non-zero mean impulse, with W the contact's own
-/// 2x2 Delassus block, r its impulse and r_after the check's solution:
-/// dV = W (r_after - r), the change of velocity the contact still wants (m/s),
-/// r_bar = (r + r_after)/2, WR = W r (m/s), WRR = (W r.r before + after)/2.
-/// (dV is neither the change of u since the previous sweep, blind to a closed IQS
-/// contact whose impulse still moves, nor a sweep's own change, which carries what the
-/// contacts before it in the sweep just did: docs/laws.md.)
-/// - QuadWR = sqrt(sum (|WR_before|^2 + |WR_after|^2)/2 / N), MeanWRR = sum WRR / N;
-/// - QuadDV = sqrt(sum |dV|^2 / N) / (QuadWR tol), MaxmDV with max |dV|^2;
-/// - QuadDVR = sqrt(sum |dV|^2 |r_bar|^2 / N) / (MeanWRR tol), MaxmDVR with the max;
-/// - MeanDVoR = sum r_bar.dV / (sum WRR tol).
-/// "Quad" has converged when |MeanDVoR|, QuadDV and QuadDVR are all below 1,
-/// "Maxm" when |MeanDVoR|, MaxmDV and MaxmDVR are.
+/// @file The one interface of the contact solvers: their controls (SolverParameters, the
+/// case's Solver subsection), what a solve reports (SolveReport) and ContactSolver, which
+/// MoreauJean holds. Each method is one file pair in dem/solvers/ and one row of the table
+/// in dem/solvers/methods.cc (its name, whether it solves Coulomb friction, its own
+/// entries, its constructor).
 
+#include "core/parameter_section.h"
+#include "dem/body_state.h"
 #include "dem/contact.h"
 #include "dem/contact_law.h"
 
-#include <Eigen/Core>
-
-#include <array>
-#include <random>
+#include <memory>
 #include <string>
 #include <vector>
+
+namespace dealii
+{
+  class ParameterHandler;
+}
 
 namespace tribo::dem
 {
   /// Controls of the contact solve: the method, and the NLGS's own controls.
   struct SolverParameters
   {
-    /// The method: nonlinear Gauss-Seidel (below); on the frictionless problem, the
-    /// active-set (projected Newton) method with the sparse Delassus operator factorised
-    /// by CHOLMOD (dem/active_set.h), the matrix-free MPRGP (dem/mprgp.h) and APGD
-    /// (dem/apgd.h), APGS, Gauss-Seidel sweeps with momentum (dem/apgs.h), or the primal-dual interior-point method, also with CHOLMOD
-    /// (dem/interior_point.h). With
-    /// friction APGS solves the Coulomb law itself (solves_friction()); the other global
-    /// methods hand the step to NLGS and say so.
+    /// The method, one row each in the table of dem/solvers/methods.cc: nonlinear
+    /// Gauss-Seidel (dem/solvers/nlgs.h); on the frictionless problem, the active-set
+    /// (projected Newton) method with the sparse Delassus operator factorised by CHOLMOD
+    /// (active_set.h), the matrix-free MPRGP (mprgp.h) and APGD (apgd.h), APGS, Gauss-Seidel
+    /// sweeps with momentum (apgs.h), or the primal-dual interior-point method, also with
+    /// CHOLMOD (interior_point.h). NLGS and APGS solve the Coulomb law themselves
+    /// (solves_friction()); the other methods hand a frictional step to NLGS and say so.
     enum class Method
     {
       nlgs,
@@ -51,7 +40,7 @@ namespace tribo::dem
       apgd,
       apgs
     };
-    Method method = Method::nlgs; ///< (a case file's default is apgs: dem/parameters.cc)
+    Method method = Method::apgs; ///< the Method entry's default too
     /// NLGS's stopping entries (Tolerance, Norm, Check interval, Gap tolerance) a case file set although
     /// the method is another, with where they were set ("Solver/Tolerance (case.prm:24)"):
     /// they then act only on the steps NLGS solves (friction), and the run log says so.
@@ -66,7 +55,7 @@ namespace tribo::dem
     /// interior point: iterations per step before it stops, not converged.
     unsigned int max_factorizations = 50;
     /// Global methods: the solve ends when the natural map max |min(x, w / W_nn)|
-    /// (dem/frictionless_problem.h) is below this times the iterate's mean loaded impulse
+    /// (dem/solvers/frictionless_problem.h) is below this times the iterate's mean loaded impulse
     /// (the law residual, dem/law_residual.h; the active set and the interior-point method
     /// also stop at their round-off floors). The default, 1e-3, is below the 1.2-1.5e-3
     /// NLGS leaves on average at Quad 1e-4 in steady shear: at 1.5e-3 MPRGP let an overlap
@@ -138,39 +127,13 @@ namespace tribo::dem
     ParameterSection section;
 
     /// Declare the solver's entries in the current subsection of @p prm (the caller
-    /// enters and leaves it).
+    /// enters and leaves it): the entries every method reads (contact_solver.cc), then each
+    /// method's own (its row's declare).
     static void declare(dealii::ParameterHandler &prm);
-    /// The controls of subsection @p section of @p file, checked; InputError names the
-    /// file, the line and the entry.
+    /// The controls of subsection @p section of @p file, checked, in the same order;
+    /// InputError names the file, the line and the entry.
     static SolverParameters parse(const ParameterFile &file, const std::string &section);
   };
-
-  /// Whether @p method solves the law with Coulomb friction itself (NLGS and APGS); the
-  /// other methods hand a frictional step to NLGS.
-  inline bool solves_friction(SolverParameters::Method method)
-  {
-    return method == SolverParameters::Method::nlgs || method == SolverParameters::Method::apgs;
-  }
-
-  /// The name of @p method as the Method entry (SolverParameters::declare()) spells it.
-  inline std::string method_name(SolverParameters::Method method)
-  {
-    switch (method)
-      {
-        case SolverParameters::Method::active_set:
-          return "active-set";
-        case SolverParameters::Method::mprgp:
-          return "mprgp";
-        case SolverParameters::Method::interior_point:
-          return "interior-point";
-        case SolverParameters::Method::apgd:
-          return "apgd";
-        case SolverParameters::Method::apgs:
-          return "apgs";
-        default:
-          return "nlgs";
-      }
-  }
 
   /// What one solve achieved.
   struct SolveReport
@@ -180,6 +143,9 @@ namespace tribo::dem
     /// back to NLGS (which then reports its sweeps in iterations).
     unsigned int factorizations = 0;
     bool         fell_back      = false;
+    /// Whether NLGS solved the step (the method is NLGS, or it handed a frictional step
+    /// to NLGS, or the active set fell back): residual is then NLGS's criterion.
+    bool solved_by_nlgs = false;
     /// The law residual after the solve (dem/law_residual.h), max |phi| / mean loaded
     /// impulse: the same measure whatever the method.
     double law_residual = 0;
@@ -201,95 +167,35 @@ namespace tribo::dem
     double gap_violation = 0;
   };
 
-  /// Velocities and inverse masses of the bodies as the solver sees them:
-  /// (v_x, v_y, spin) and (1/m, 1/m, 1/I), with 0 for imposed-velocity dofs.
-  struct BodyState
-  {
-    std::vector<Eigen::Vector3d>       velocity;
-    std::vector<std::array<double, 3>> inverse_mass;
-    /// Velocities of the boundary nodes of a BoundaryBody (2n: x, y per node), m/s,
-    /// and its compliance (dem/boundary.h); empty / null without one.
-    Eigen::VectorXd        node_velocity;
-    const Eigen::MatrixXd *node_compliance = nullptr;
 
-    /// The current velocities and inverse masses of @p system's bodies (no boundary body).
-    static BodyState of(const ParticleSystem &system)
-    {
-      BodyState state;
-      for (const auto &b : system.bodies)
-        {
-          state.velocity.push_back({b.velocity.x(), b.velocity.y(), b.spin});
-          state.inverse_mass.push_back(b.inverse_mass());
-        }
-      return state;
-    }
-
-    /// Local velocity of contact @p c from the current body velocities.
-    Eigen::Vector2d local_velocity(const Contact &c) const
-    {
-      if (c.on_boundary())
-        return boundary_local_velocity(c);
-      const Eigen::Vector3d &v0 = velocity[c.body[0]], &v1 = velocity[c.body[1]];
-      const Vec2             t(-c.normal.y(), c.normal.x());
-      return {c.normal.dot(v1.head<2>() - v0.head<2>()) + c.arm_n[1] * v1.z() - c.arm_n[0] * v0.z(),
-              t.dot(v1.head<2>() - v0.head<2>()) + c.arm_t[1] * v1.z() - c.arm_t[0] * v0.z()};
-    }
-
-    /// Apply impulse @p dr of contact @p c: v_1 += M_1^-1 H_1 dr, v_0 -= M_0^-1 H_0 dr.
-    void apply_impulse(const Contact &c, const Eigen::Vector2d &dr)
-    {
-      if (c.on_boundary())
-        return apply_boundary_impulse(c, dr);
-      const Vec2 t(-c.normal.y(), c.normal.x());
-      const Vec2 f = dr.x() * c.normal + dr.y() * t;
-      for (int s = 0; s < 2; ++s)
-        {
-          const double           sign = s == 0 ? -1.0 : 1.0;
-          const auto            &im   = inverse_mass[c.body[s]];
-          Eigen::Vector3d       &v    = velocity[c.body[s]];
-          v.x() += sign * im[0] * f.x();
-          v.y() += sign * im[1] * f.y();
-          v.z() += sign * im[2] * (c.arm_n[s] * dr.x() + c.arm_t[s] * dr.y());
-        }
-    }
-
-    /// The own Delassus block of @p c, sum over its two bodies of H^T M^-1 H (for a
-    /// half-disc contact: the grain's part plus B^T G_AB B, with B the 4x2 map from
-    /// (r_n, r_t) to the impulses -J_A^T f, -J_B^T f on its two nodes, dem/boundary.h).
-    Eigen::Matrix2d delassus_block(const Contact &c) const;
-
-    /// Side 0 of a half-disc contact: velocity of the half-disc's material point at the
-    /// contact point, J_A v_A + J_B v_B (Contact::node_map), m/s.
-    Vec2 half_disc_velocity(const Contact &c) const
-    {
-      return c.node_map[0] * node_velocity.segment<2>(2 * c.node[0]) +
-             c.node_map[1] * node_velocity.segment<2>(2 * c.node[1]);
-    }
-
-  private:
-    Eigen::Vector2d boundary_local_velocity(const Contact &c) const;
-    void            apply_boundary_impulse(const Contact &c, const Eigen::Vector2d &dr);
-  };
-
-  /// The solver; it keeps its random generator across steps (reproducible from the seed).
-  class NlgsSolver
+  /// A contact solver: it finds the impulses of one step's local problems.
+  class ContactSolver
   {
   public:
-    explicit NlgsSolver(const SolverParameters &p = {});
-    /// Solve for the impulses of @p contacts (warm-started from their r, whose
-    /// effect must already be in @p state), updating @p state. @p theta_h = theta h
-    /// turns velocity violations into gap violations for SolverParameters::gap_tolerance.
-    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law,
-                     double theta_h = 0);
-
+    explicit ContactSolver(const SolverParameters &p) : prm(p) {}
+    virtual ~ContactSolver() = default;
+    /// Solve for the impulses of @p contacts (warm-started from their r, whose effect must
+    /// already be in @p state) under @p law, updating them and @p state. @p theta_h = theta h
+    /// turns velocity violations into gap violations (m). Without contacts: an empty report.
+    virtual SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law,
+                              double theta_h = 0) = 0;
     const SolverParameters &parameters() const { return prm; }
-    /// The random generator's state as text (checkpoints), and its restoration.
-    std::string random_state() const;
-    void        set_random_state(const std::string &state);
+    /// Whether the method solves the law with Coulomb friction itself (NLGS, APGS); the
+    /// others hand a frictional step to NLGS (dem/solvers/global_solver.h).
+    virtual bool solves_friction() const = 0;
+    /// The state of the random contact order as text (checkpoints), and its restoration.
+    virtual std::string random_state() const = 0;
+    virtual void        set_random_state(const std::string &state) = 0;
 
-  private:
-    SolverParameters            prm;
-    std::mt19937              rng;
-    std::vector<unsigned int> order;
+  protected:
+    SolverParameters prm;
   };
+
+  /// The solver of @p prm.method, built from @p prm.
+  std::unique_ptr<ContactSolver> make_contact_solver(const SolverParameters &prm);
+  /// Whether @p method solves the law with Coulomb friction itself (NLGS and APGS); the
+  /// other methods hand a frictional step to NLGS.
+  bool solves_friction(SolverParameters::Method method);
+  /// The name of @p method as the Method entry spells it ("interior-point").
+  std::string method_name(SolverParameters::Method method);
 } // namespace tribo::dem

@@ -1,7 +1,8 @@
-#include "dem/active_set.h"
+#include "dem/solvers/active_set.h"
 
 #include "core/errors.h"
-#include "dem/frictionless_problem.h"
+#include "core/parameter_file.h"
+#include "dem/solvers/frictionless_problem.h"
 
 #include <Eigen/CholmodSupport>
 
@@ -11,6 +12,20 @@
 
 namespace tribo::dem
 {
+  void ActiveSetSolver::declare(dealii::ParameterHandler &prm)
+  {
+    prm.declare_entry("Regularization", "1e-8", dealii::Patterns::Double(),
+                      "Active set: relative regularisation delta in [0, 1e-4] of the Newton matrix "
+                      "W_FF + delta diag(W_FF) (redundant contacts make W_FF singular); it changes "
+                      "the Newton step, not the solution.");
+  }
+
+  void ActiveSetSolver::parse(const ParameterFile &f, SolverParameters &p)
+  {
+    p.regularization = f.get_checked(p.section.entry("Regularization"),
+                                     [](double v) { return v >= 0 && v <= 1e-4; }, "a regularisation in [0, 1e-4]");
+  }
+
   SolveReport ActiveSetSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
   {
     SolveReport report;

@@ -1,16 +1,16 @@
 #pragma once
 /// @file The closed-set pieces of the frictionless contact problem's direct methods, in the
-/// scaled variables of dem/frictionless_problem.h (y = D^(1/2) x, operator A' + U'U'^T,
+/// scaled variables of dem/solvers/frictionless_problem.h (y = D^(1/2) x, operator A' + U'U'^T,
 /// g = A'y + U'U'^T y + b'):
 /// - ShiftedFactorisation: CHOLMOD's LL^T of K = A' + diag(barrier), with the walls'
 ///   low-rank part U'U'^T through Sherman-Morrison-Woodbury (the interior point's Newton
-///   matrix, dem/interior_point.h);
+///   matrix, dem/solvers/interior_point.h);
 /// - least_norm_crossover(): from an approximate solution y and its closed set C, the
 ///   impulses that close C exactly (the interior point's crossover; from APGD's or APGS's
 ///   iterates it fails, docs/performance.md).
 
-#include "dem/bisected_cholesky.h"
-#include "dem/frictionless_problem.h"
+#include "dem/solvers/bisected_cholesky.h"
+#include "dem/solvers/frictionless_problem.h"
 
 #include <Eigen/CholmodSupport>
 
@@ -22,7 +22,7 @@ namespace tribo::dem
   /// LL^T: twice as fast as its supernodal one with Debian's reference BLAS on the
   /// 3800-grain benchmark, docs/performance.md); given a @p partition of its rows (from 4000
   /// contacts, with a small separator), in two halves on both cores
-  /// (dem/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
+  /// (dem/solvers/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
   /// each factorise() is one numeric factorisation. Whole, K is kept as the upper triangle
   /// of P K P^T (permuted_upper()), P the fill-reducing ordering, so that CHOLMOD
   /// factorises it as given: with its own ordering it would transpose K at every

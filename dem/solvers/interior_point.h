@@ -1,9 +1,9 @@
 #pragma once
 /// @file A primal-dual interior-point method (Mehrotra's predictor-corrector) for the
-/// frictionless contact problem (dem/frictionless_problem.h), on the sparse Delassus
+/// frictionless contact problem (dem/solvers/frictionless_problem.h), on the sparse Delassus
 /// operator factorised by CHOLMOD.
 ///
-/// In the diagonally scaled variables of dem/mprgp.h (y = D^(1/2) x, A' = D^(-1/2) A
+/// In the diagonally scaled variables of dem/solvers/mprgp.h (y = D^(1/2) x, A' = D^(-1/2) A
 /// D^(-1/2), b' = D^(-1/2) b), the problem 0 <= y _|_ s = A'y + b' >= 0 is followed along
 /// its central path y_i s_i = mu > 0, mu -> 0. With the residual r = A'y + b' - s, each
 /// iteration solves twice with one factorisation of
@@ -11,7 +11,7 @@
 ///                             redundancy of the contacts: no regularisation needed)
 /// (CHOLMOD's simplicial LL^T: faster than its supernodal one with reference BLAS here).
 /// A wall clump touched by m contacts would make an m x m dense block of K; it is kept
-/// out as the rank-1..3 term U U^T (dem/delassus.h, bodies with more than 64 contacts),
+/// out as the rank-1..3 term U U^T (dem/solvers/delassus.h, bodies with more than 64 contacts),
 /// K_s = K - U U^T is factorised and K solved by Sherman-Morrison-Woodbury with one step
 /// of iterative refinement (1.7 times faster per step at 16 000 grains, docs/performance.md);
 /// - predictor: K dy = -r - s, ds = A' dy + r; the largest step alpha_a that keeps y, s >= 0
@@ -41,18 +41,17 @@
 /// like 1 / mu), keeping its iterate (reported not converged). Cost per iteration: one numeric factorisation (the symbolic analysis once
 /// per step), two solves, two products with A'.
 
-#include "dem/frictionless_solver.h"
+#include "dem/solvers/global_solver.h"
 
 namespace tribo::dem
 {
-  class InteriorPointSolver : public FrictionlessSolver
+  class InteriorPointSolver : public GlobalSolver
   {
   public:
-    using FrictionlessSolver::FrictionlessSolver;
+    using GlobalSolver::GlobalSolver;
+
+  protected:
     /// The report counts factorizations.
     SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &) override;
-
-  private:
-    const char *name() const override { return "interior-point"; }
   };
 } // namespace tribo::dem

@@ -1,7 +1,7 @@
-#include "dem/sweep_problem.h"
+#include "dem/solvers/sweep_problem.h"
 
-#include "dem/delassus.h"
-#include "dem/nlgs.h"
+#include "dem/solvers/delassus.h"
+#include "dem/body_state.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,12 @@
 #pragma once
-/// @file The contact problem of a step as the Gauss-Seidel sweeps of APGS (dem/apgs.h) see it:
+/// @file The contact problem of a step as the Gauss-Seidel sweeps of APGS (dem/solvers/apgs.h) see it:
 /// scaled variables, one row per contact without friction, two with Coulomb friction.
 ///
-/// Frictionless (width 1): the scaled problem of dem/frictionless_problem.h, y = D^(1/2) r~,
+/// Frictionless (width 1): the scaled problem of dem/solvers/frictionless_problem.h, y = D^(1/2) r~,
 /// the operator A' + U'U'^T with a unit diagonal.
 ///
 /// Coulomb friction mu (width 2): contact i has rows 2i (normal) and 2i + 1 (tangent) of the
-/// full Delassus operator (dem/delassus.h), x = (r~_n, r_t) = (r_n + gamma h, r_t) (N s/m),
+/// full Delassus operator (dem/solvers/delassus.h), x = (r~_n, r_t) = (r_n + gamma h, r_t) (N s/m),
 ///     u~ = (W + C) x + b,  b = u_free + (shift, 0) - W (gamma h, 0)      (m/s),
 /// with C the ELAS compliance on the normal rows (dem/contact_law.h). Both components of a
 /// contact share one scale s_i = (W_nn,i + C_i)^(-1/2): y = x / s_i, A' = S (W + C) S,
@@ -15,7 +15,7 @@
 /// |y_t| < mu y_n, else y_t = -mu y_n sign(u_t)) is solved locally in closed form by
 /// ContactLaw::solve_coulomb() against the contact's own 2x2 block of A' + U'U'^T (own_block).
 
-#include "dem/frictionless_problem.h"
+#include "dem/solvers/frictionless_problem.h"
 
 #include <Eigen/Core>
 

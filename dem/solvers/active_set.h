@@ -1,6 +1,6 @@
 #pragma once
 /// @file The active-set (projected Newton) method for the frictionless contact problem,
-/// on the sparse Delassus operator (dem/delassus.h).
+/// on the sparse Delassus operator (dem/solvers/delassus.h).
 ///
 /// With x = r~ = r_n + gamma h the shifted normal impulses (N s/m) and
 ///     w = A x + b,  A = W_nn + C,  b = u_free,n + shift - W_nn (gamma h)
@@ -24,20 +24,24 @@
 /// within the step), one numeric factorisation per iteration, sparse products in the
 /// line search. docs/laws.md gives the derivation and the measured behaviour.
 
-#include "dem/frictionless_solver.h"
+#include "dem/solvers/global_solver.h"
 
 namespace tribo::dem
 {
-  class ActiveSetSolver : public FrictionlessSolver
+  class ActiveSetSolver : public GlobalSolver
   {
   public:
-    using FrictionlessSolver::FrictionlessSolver;
+    using GlobalSolver::GlobalSolver;
+    /// Its own entry, Regularization (SolverParameters::regularization), declared in the
+    /// current subsection and read into @p prm.
+    static void declare(dealii::ParameterHandler &prm);
+    static void parse(const ParameterFile &file, SolverParameters &prm);
+
+  protected:
     /// The report counts factorizations; if it is not converged within
     /// SolverParameters::max_factorizations, the contacts and the state are left as they
-    /// came (the caller then solves with NLGS).
+    /// came (GlobalSolver then solves the step with NLGS).
     SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &) override;
-
-  private:
-    const char *name() const override { return "active-set"; }
+    bool        falls_back_to_nlgs() const override { return true; }
   };
 } // namespace tribo::dem
