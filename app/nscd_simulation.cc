@@ -73,7 +73,7 @@ namespace tribo::app
     struct SolverRecord
     {
       unsigned long total_iterations = 0, non_converged = 0, max_iterations = 0;
-      double        worst_overlap = 0, max_residual = 0;
+      double        worst_overlap = 0, max_residual = 0, max_speed = 0;
       /// The law residual (dem/law_residual.h) over the steps, and the active set's work.
       double        max_law_residual = 0, sum_law_residual = 0, max_gap_violation = 0;
       unsigned long total_factorizations = 0, fallbacks = 0, gap_exceeded = 0;
@@ -90,16 +90,19 @@ namespace tribo::app
         fallbacks += r.solver.fell_back ? 1 : 0;
         gap_exceeded += r.solver.gap_exceeded ? 1 : 0;
         worst_overlap = std::max(worst_overlap, r.max_overlap);
+        max_speed     = std::max(max_speed, r.max_speed);
       }
       void save(CheckpointOut &ar) const
       {
         ar << total_iterations << non_converged << max_iterations << worst_overlap << max_residual
-           << max_law_residual << sum_law_residual << max_gap_violation << total_factorizations << fallbacks << gap_exceeded;
+           << max_law_residual << sum_law_residual << max_gap_violation << total_factorizations << fallbacks << gap_exceeded
+           << max_speed;
       }
       void load(CheckpointIn &ar)
       {
         ar >> total_iterations >> non_converged >> max_iterations >> worst_overlap >> max_residual >>
-          max_law_residual >> sum_law_residual >> max_gap_violation >> total_factorizations >> fallbacks >> gap_exceeded;
+          max_law_residual >> sum_law_residual >> max_gap_violation >> total_factorizations >> fallbacks >> gap_exceeded >>
+          max_speed;
       }
     };
 
@@ -314,6 +317,7 @@ namespace tribo::app
         summary.set("gap_target_exceeded", long(record.gap_exceeded));
         summary.set("max_overlap", record.worst_overlap);
         summary.set("max_overlap_over_min_radius", record.worst_overlap / system.min_radius());
+        summary.set("max_body_speed", record.max_speed);
         summary.set("n_bodies", long(system.bodies.size()));
         summary.set("n_discs", long(system.discs.size()));
         summary.set("timing", timing.to_json());

@@ -20,8 +20,10 @@ namespace tribo
     /// First entry of every checkpoint: what it is and its layout version (2: the wall time
     /// follows the parameters, and the SPH and MLP scenes checkpoint; 3: the SPH solver
     /// carries its viscous heat; 4: a particle first body carries its chain's mean
-    /// velocity over the last step, the shear scene its upper body's speed at Shear start).
-    const std::string magic = "tribo checkpoint 4";
+    /// velocity over the last step, the shear scene its upper body's speed at Shear start;
+    /// 5: the NSCD run's record carries the steps above the gap target and the fastest
+    /// body's speed).
+    const std::string magic = "tribo checkpoint 5";
   } // namespace
 
   void write_checkpoint(const std::string &path, const std::function<void(CheckpointOut &)> &save)

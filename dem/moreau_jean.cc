@@ -72,6 +72,7 @@ namespace tribo::dem
     const double deepest_overlap = measure_gaps(h, report);
     sum_contact_forces(h);
     const auto fastest = update_bodies(system, h, report);
+    report.max_speed   = fastest.first;
     if (boundary)
       update_boundary_body(h, report);
     compute_contact_powers(h);

@@ -44,6 +44,8 @@ namespace tribo::dem
     double epsilon = 0;
     /// Largest overlap at the end of the step, max(0, -min g_end), m.
     double max_overlap = 0;
+    /// Speed of the fastest body at the end of the step, |v| of its centre of mass, m/s.
+    double max_speed = 0;
     double kinetic_energy = 0; ///< after the step, J/m
     /// Power of the drivers: reactions of imposed-velocity dofs (minus the contact
     /// force on them) and imposed loads, times the mean velocity over the step, W/m.
