@@ -127,8 +127,8 @@ namespace tribo::dem
     ParameterSection section;
 
     /// Declare the solver's entries in the current subsection of @p prm (the caller
-    /// enters and leaves it): the entries every method reads (contact_solver.cc), then each
-    /// method's own (its row's declare).
+    /// enters and leaves it): the entries every method reads, then each method's own (its
+    /// row's declare); dem/solvers/methods.cc.
     static void declare(dealii::ParameterHandler &prm);
     /// The controls of subsection @p section of @p file, checked, in the same order;
     /// InputError names the file, the line and the entry.
@@ -191,6 +191,7 @@ namespace tribo::dem
     SolverParameters prm;
   };
 
+  // Defined with the table of methods (dem/solvers/methods.cc):
   /// The solver of @p prm.method, built from @p prm.
   std::unique_ptr<ContactSolver> make_contact_solver(const SolverParameters &prm);
   /// Whether @p method solves the law with Coulomb friction itself (NLGS and APGS); the

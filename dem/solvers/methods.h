@@ -1,6 +1,7 @@
 #pragma once
-/// @file The table of the contact solver methods: one row per method. Adding a method is its
-/// files in dem/solvers/, its value of SolverParameters::Method and its row in methods.cc.
+/// @file The table of the contact solver methods, one row per method, and with it (methods.cc)
+/// the Solver subsection's entries and make_contact_solver(). Adding a method is its files in
+/// dem/solvers/, its value of SolverParameters::Method and its row in methods.cc.
 
 #include "dem/solvers/contact_solver.h"
 
