@@ -16,7 +16,10 @@
 # e.g. bash bench/solver_scaling.sh width 1000 4000 16000 -- "Solver/Method=nlgs" \
 #          "Solver/Method=mprgp Solver/Residual target=1.5e-3"
 # Samples are kept in ${SCALING_DIR:-/tmp/tribo-solver-scaling}/<mode>-<N>; an existing
-# checkpoint is reused. Run it on an otherwise idle machine.
+# checkpoint is reused. With FRICTION=MU the samples have Coulomb friction MU between grains
+# and at the walls from the start (a resumed run may not change the contact law), are made by
+# APGS (which solves friction) instead of APGD, and are kept in <mode>-<N>-mu<MU>.
+# Run it on an otherwise idle machine.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 tribo=${TRIBO:-$here/build/bin/tribo}
@@ -41,13 +44,18 @@ for n in "${sizes[@]}"; do
   compaction=1000  # steps of 1e-8 s
   [ "$mode" = thickness ] && compaction=$(/usr/bin/python3 -c "print(max(1000, round(1000 * $n / 3800)))")
   dir="$root/$mode-$n"
+  law=(--set "Solver/Method=apgd")
+  if [ -n "${FRICTION:-}" ]; then
+    dir="$dir-mu$FRICTION"
+    law=(--set "Contact law/Friction coefficient=$FRICTION" --set "Solver/Method=apgs")
+  fi
   if [ ! -f "$dir/checkpoint.bin" ]; then
     rm -rf "$dir"
     end=$(/usr/bin/python3 -c "print(($compaction + $shear + 3000) * 1e-8)")  # stopped at the checkpoint
     "$tribo" run "$here/cases/shear/reference_bench.prm" --output "$dir" --quiet \
       --set "Shear cell/Number of discs=$n" --set "Shear cell/Length=$length" \
       --set "Shear cell/Wall discs=$walls" --set "Shear cell/Shear start=$(/usr/bin/python3 -c "print($compaction * 1e-8)")" \
-      --set "Simulation/End time=$end" --set "Solver/Method=apgd" \
+      --set "Simulation/End time=$end" "${law[@]}" \
       --set "Solver/Residual target=1e-3" --set "Solver/Threads=2" \
       --set "Output/Checkpoint step interval=$((compaction + shear))" --set "Output/Plots=false" &
     pid=$!
@@ -56,6 +64,6 @@ for n in "${sizes[@]}"; do
     wait "$pid" || true
     [ -f "$dir/checkpoint.bin" ] || { echo "$0: $dir: no checkpoint (see its log.txt)" >&2; exit 1; }
   fi
-  echo "## $mode, $n grains (period $length m, $walls wall discs)"
+  echo "## $mode, $n grains (period $length m, $walls wall discs${FRICTION:+, friction $FRICTION})"
   bash "$here/bench/solver_methods.sh" "$dir" "$steps" "$@"
 done
