@@ -4,8 +4,10 @@ work the contacts gave back (max of h P_contacts over the steps) over the driver
 the run (sum of h P_external), the contacts' work summed over the run over the drivers' work,
 the fastest body (m/s) and the worst overlap over the smallest radius.
 
-Frictionless IQS contacts without cohesion can only take energy: a positive step is energy
-the solve made (docs/performance.md, "A wall landing during the shear").
+Over a run, frictionless IQS contacts without cohesion take energy. A single step may give
+a little back even when solved exactly: at midpoint velocities, a contact that opens at the
+step's start while the load closes it does positive work. Much more than converged solves
+give back points at the solve (docs/performance.md, "A wall landing during the shear").
 
 Usage: contact_work.py RUN_DIRECTORY...
 """
