@@ -196,13 +196,11 @@ declare_scene_subsections(prm);
 
   CaseParameters read_case_parameters(const ParameterFile &f)
   {
-    const auto positive     = [](double v) { return v > 0 && std::isfinite(v); };
-    const auto non_negative = [](double v) { return v >= 0 && std::isfinite(v); };
 
     CaseParameters p;
     p.scene     = f.get("Simulation/Scene");
-    p.time_step = f.get_checked("Simulation/Time step", positive, "a positive time step in s");
-    p.end_time  = f.get_checked("Simulation/End time", positive, "a positive end time in s");
+    p.time_step = f.get_checked("Simulation/Time step", is_positive, "a positive time step in s");
+    p.end_time  = f.get_checked("Simulation/End time", is_positive, "a positive end time in s");
     p.theta     = f.get_double("Simulation/Theta");
 
     p.law    = dem::ContactLaw::parse(f, "Contact law");
@@ -217,15 +215,15 @@ declare_scene_subsections(prm);
     auto &c = p.collision;
     if (p.scene == "collision")
       {
-        c.diameter = f.get_checked("Collision/Diameter", positive, "a positive diameter in m");
-        c.density  = f.get_checked("Collision/Density", positive, "a positive density in kg/m^3");
+        c.diameter = f.get_checked("Collision/Diameter", is_positive, "a positive diameter in m");
+        c.density  = f.get_checked("Collision/Density", is_positive, "a positive density in kg/m^3");
         c.impact_velocity = f.get_checked("Collision/Impact velocity",
                                           [](double v) { return v != 0 && std::isfinite(v); },
                                           "a non-zero velocity in m/s");
         c.initial_gap = f.get_checked("Collision/Initial gap",
                                       [&](double v) { return v > -0.5 * c.diameter; },
                                       "a gap in m larger than minus half the diameter");
-        c.time_step_ratio = f.get_checked("Collision/Time step ratio", non_negative, "a ratio >= 0");
+        c.time_step_ratio = f.get_checked("Collision/Time step ratio", is_non_negative, "a ratio >= 0");
         c.stop_when_separated = f.get_bool("Collision/Stop when separated");
       }
 
@@ -234,10 +232,10 @@ declare_scene_subsections(prm);
       {
         const std::string S = "Shear cell/";
         sc.n_discs         = f.get_integer(S + "Number of discs");
-        sc.mean_diameter   = f.get_checked(S + "Mean diameter", positive, "a positive diameter in m");
+        sc.mean_diameter   = f.get_checked(S + "Mean diameter", is_positive, "a positive diameter in m");
         sc.diameter_spread = f.get_double(S + "Diameter spread");
-        sc.density         = f.get_checked(S + "Density", positive, "a positive density in kg/m^3");
-        sc.length          = f.get_checked(S + "Length", positive, "a positive length in m");
+        sc.density         = f.get_checked(S + "Density", is_positive, "a positive density in kg/m^3");
+        sc.length          = f.get_checked(S + "Length", is_positive, "a positive length in m");
         const double d_max = sc.mean_diameter * (1 + sc.diameter_spread);
         if (sc.length < 8 * d_max)
           f.fail(S + "Length", "a length of at least 8 largest diameters (" + to_text(8 * d_max) + " m)");
@@ -251,14 +249,14 @@ declare_scene_subsections(prm);
         if (sc.wall_discs > 0 && sc.wall_discs * d_wall > sc.length * (1 + 1e-12))
           f.fail(S + "Wall discs", "at most " + std::to_string(int(sc.length / d_wall * (1 + 1e-12))) +
                                      " discs, so that they fit along the length without overlapping");
-        sc.pressure  = f.get_checked(S + "Pressure", positive, "a positive pressure in Pa");
-        sc.ramp_time = f.get_checked(S + "Pressure ramp time", non_negative, "a time >= 0 in s");
+        sc.pressure  = f.get_checked(S + "Pressure", is_positive, "a positive pressure in Pa");
+        sc.ramp_time = f.get_checked(S + "Pressure ramp time", is_non_negative, "a time >= 0 in s");
         sc.sliding_velocity = f.get_checked(S + "Sliding velocity", [](double v) { return std::isfinite(v); }, "a velocity in m/s");
-        sc.shear_start = f.get_checked(S + "Shear start", non_negative, "a time >= 0 in s");
-        sc.compaction_speed = f.get_checked(S + "Compaction speed limit", non_negative, "a speed >= 0 in m/s");
-        sc.upper_body_thickness = f.get_checked(S + "Upper body thickness", positive, "a positive thickness in m");
+        sc.shear_start = f.get_checked(S + "Shear start", is_non_negative, "a time >= 0 in s");
+        sc.compaction_speed = f.get_checked(S + "Compaction speed limit", is_non_negative, "a speed >= 0 in m/s");
+        sc.upper_body_thickness = f.get_checked(S + "Upper body thickness", is_positive, "a positive thickness in m");
         sc.profile_samples = f.get_integer(S + "Profile samples");
-        sc.layer_thickness = f.get_checked(S + "Layer thickness", non_negative, "a thickness >= 0 in m");
+        sc.layer_thickness = f.get_checked(S + "Layer thickness", is_non_negative, "a thickness >= 0 in m");
         sc.seed = f.get_integer(S + "Seed");
         if (const std::string sample = f.get(S + "Sample file"); !sample.empty())
           {

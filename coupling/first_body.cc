@@ -133,8 +133,6 @@ namespace tribo::coupling
 
   FirstBodyParameters FirstBodyParameters::parse(const ParameterFile &f, const std::string &section)
   {
-    const auto positive     = [](double v) { return v > 0 && std::isfinite(v); };
-    const auto non_negative = [](double v) { return v >= 0 && std::isfinite(v); };
     FirstBodyParameters p;
     p.section        = {section};
     const auto entry = [&](const std::string &name) { return p.section.entry(name); };
@@ -143,20 +141,20 @@ namespace tribo::coupling
                                       [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
     p.verlet_fraction = f.get_checked(entry("Upper body Verlet fraction"), [](double v) { return v > 0 && v <= 0.5; },
                                       "a fraction of the stability limit in (0, 0.5]");
-    p.prediction_depth = f.get_checked(entry("Upper body prediction depth"), non_negative,
+    p.prediction_depth = f.get_checked(entry("Upper body prediction depth"), is_non_negative,
                                        "a depth >= 0 in wave reaches c_p h");
-    p.youngs_modulus = f.get_checked(entry("Upper body Young's modulus"), positive, "a positive modulus in Pa");
+    p.youngs_modulus = f.get_checked(entry("Upper body Young's modulus"), is_positive, "a positive modulus in Pa");
     p.poisson_ratio  = f.get_checked(entry("Upper body Poisson ratio"), [](double v) { return v > -1 && v < 0.5; },
                                      "a Poisson ratio in (-1, 0.5)");
-    p.resolution     = f.get_checked(entry("Upper body cell size"), non_negative, "a size >= 0 in m");
+    p.resolution     = f.get_checked(entry("Upper body cell size"), is_non_negative, "a size >= 0 in m");
     p.degree         = f.get_integer(entry("Upper body element degree"));
     p.modes          = f.get_integer(entry("Upper body modes"));
-    p.rayleigh_mass  = f.get_checked(entry("Upper body mass damping"), non_negative, "a coefficient >= 0 in 1/s");
+    p.rayleigh_mass  = f.get_checked(entry("Upper body mass damping"), is_non_negative, "a coefficient >= 0 in 1/s");
     p.rayleigh_stiffness =
-      f.get_checked(entry("Upper body stiffness damping"), non_negative, "a coefficient >= 0 in s");
-    p.half_disc_diameter = f.get_checked(entry("Half-disc diameter"), non_negative, "a diameter >= 0 in m");
+      f.get_checked(entry("Upper body stiffness damping"), is_non_negative, "a coefficient >= 0 in s");
+    p.half_disc_diameter = f.get_checked(entry("Half-disc diameter"), is_non_negative, "a diameter >= 0 in m");
     p.compaction_damping =
-      f.get_checked(entry("Upper body compaction damping"), non_negative, "a damping ratio >= 0");
+      f.get_checked(entry("Upper body compaction damping"), is_non_negative, "a damping ratio >= 0");
     return p;
   }
 

@@ -46,10 +46,10 @@ namespace tribo::app
       {
         nx       = count(f, "MLP compression/Columns", 4);
         ny       = count(f, "MLP compression/Rows", 2);
-        pressure = checked(f, "MLP compression/Pressure", non_negative, "a pressure >= 0 in Pa");
-        rise     = checked(f, "MLP compression/Load rise time", non_negative, "a time >= 0 in s");
+        pressure = checked(f, "MLP compression/Pressure", is_non_negative, "a pressure >= 0 in Pa");
+        rise     = checked(f, "MLP compression/Load rise time", is_non_negative, "a time >= 0 in s");
         maps     = count(f, "MLP compression/Density maps", 0);
-        lambda   = checked(f, "MLP compression/Gaussian width", positive, "a positive lambda / r0^2, e.g. 1")
+        lambda   = checked(f, "MLP compression/Gaussian width", is_positive, "a positive lambda / r0^2, e.g. 1")
                    * s.interaction.r0 * s.interaction.r0;
         stop_h   = checked(f, "MLP compression/Stop at delta_h", [](double v) { return v >= 0 && v < 1; },
                            "a fraction of the initial platen distance in [0, 1), e.g. 0.3");

@@ -54,8 +54,6 @@ namespace tribo::app::mlp_scenes
   /// A non-negative integer entry of at least @p min.
   unsigned int count(const ParameterFile &f, const std::string &path, long min);
 
-  inline bool positive(double v) { return v > 0; }
-  inline bool non_negative(double v) { return v >= 0; }
 
   /// Reads subsection "MLP" (common to the scenes) and Simulation/End time. The (E, nu)
   /// mapping wins over Pair stiffness and Return force amplitude when Young's modulus > 0.

@@ -32,7 +32,7 @@ namespace tribo::app
         n_particles   = count(f, "MLP ordering/Particles", 2);
         enlargement   = checked(f, "MLP ordering/Region enlargement", [](double v) { return v >= 1 && v <= 4; },
                                 "a factor in [1, 4], e.g. 1.2");
-        aspect        = checked(f, "MLP ordering/Aspect ratio", positive, "a positive width/height ratio");
+        aspect        = checked(f, "MLP ordering/Aspect ratio", is_positive, "a positive width/height ratio");
         min_distance  = checked(f, "MLP ordering/Minimum distance", [](double v) { return v > 0 && v < 1; },
                                 "a fraction of r0 in (0, 1), e.g. 0.75") * s.interaction.r0;
         relaxation    = count(f, "MLP ordering/Relaxation iterations", 0);

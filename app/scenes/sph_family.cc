@@ -76,10 +76,10 @@ namespace tribo::app::sph_scenes
   sph::SolverParameters read_integration(EntryReader &r, const std::string &section)
   {
     sph::SolverParameters s;
-    s.alpha   = r.number(section + "Artificial viscosity alpha", non_negative, "alpha >= 0");
-    s.beta    = r.number(section + "Artificial viscosity beta", non_negative, "beta >= 0");
+    s.alpha   = r.number(section + "Artificial viscosity alpha", is_non_negative, "alpha >= 0");
+    s.beta    = r.number(section + "Artificial viscosity beta", is_non_negative, "beta >= 0");
     s.courant = r.number(section + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
-    s.dt_min  = r.number(section + "Step floor", positive, "a positive step floor in s");
+    s.dt_min  = r.number(section + "Step floor", is_positive, "a positive step floor in s");
     return s;
   }
 
@@ -87,7 +87,7 @@ namespace tribo::app::sph_scenes
   {
     /// VTU text of the particles: one vertex per particle with velocity (m/s), boundary
     /// force (N, N/m in 2D; from the last rate evaluation), pressure P (Pa, compression
-    /// positive), Cauchy stress sigma = -P I + S (Pa, tension positive; in 2D also the
+    /// is_positive), Cauchy stress sigma = -P I + S (Pa, tension positive; in 2D also the
     /// plane-strain sigma_zz = -P + S_zz, S_zz = -(S_xx + S_yy)), density (kg/m^3),
     /// specific internal energy (J/kg) and body id.
     template <int dim>

@@ -52,8 +52,6 @@ namespace tribo::app::sph_scenes
     const ParameterFile &file;
   };
 
-  inline bool positive(double v) { return v > 0; }
-  inline bool non_negative(double v) { return v >= 0; }
 
   /// Young's modulus E = 9 K G/(3 K + G) (Pa) and Poisson ratio
   /// nu = (3 K - 2 G)/(2 (3 K + G)) of a material's small-strain moduli (K = A for Tillotson).

@@ -39,16 +39,16 @@ namespace tribo::app
       const std::string s = plate_section + "/";
       PlateParameters   p;
       p.material  = material_named(r.text(s + "Material"));
-      p.length    = r.number(s + "Length", positive, "a positive length in m");
-      p.thickness = r.number(s + "Thickness", positive, "a positive thickness in m");
-      p.spacing   = r.number(s + "Particle spacing", positive, "a positive particle spacing in m");
+      p.length    = r.number(s + "Length", is_positive, "a positive length in m");
+      p.thickness = r.number(s + "Thickness", is_positive, "a positive thickness in m");
+      p.spacing   = r.number(s + "Particle spacing", is_positive, "a positive particle spacing in m");
       p.smoothing_ratio = r.number(s + "Smoothing length ratio", [](double v) { return v >= 1 && v <= 2; },
                                    "a ratio h/a in [1, 2]");
-      p.tip_velocity = r.number(s + "Tip velocity", positive, "a positive velocity in m/s");
+      p.tip_velocity = r.number(s + "Tip velocity", is_positive, "a positive velocity in m/s");
       p.integration  = read_integration(r, s);
-      p.end_time = r.number("Simulation/End time", positive, "a positive end time in s");
-      p.statistics_interval = r.number(s + "Statistics interval", positive, "a positive interval in s");
-      p.field_interval = r.number(s + "Field interval", non_negative, "an interval >= 0 in s");
+      p.end_time = r.number("Simulation/End time", is_positive, "a positive end time in s");
+      p.statistics_interval = r.number(s + "Statistics interval", is_positive, "a positive interval in s");
+      p.field_interval = r.number(s + "Field interval", is_non_negative, "an interval >= 0 in s");
       if (p.thickness < 3 * p.spacing || p.length < 3 * p.thickness)
         r.fail(s + "Thickness", "at least 3 particle spacings and at most a third of the length");
       return p;

@@ -80,23 +80,23 @@ namespace tribo::app
       p.dim      = static_cast<unsigned int>(std::stoi(r.text(s + "Dimension")));
       p.material = material_named(r.text(s + "Material"));
       p.lattice  = r.text(s + "Lattice") == "hcp" ? sph::LatticeType::hexagonal : sph::LatticeType::cubic;
-      p.spacing  = r.number(s + "Particle spacing", positive, "a positive particle spacing in m");
+      p.spacing  = r.number(s + "Particle spacing", is_positive, "a positive particle spacing in m");
       p.smoothing_ratio = r.number(s + "Smoothing length ratio", [](double v) { return v >= 1 && v <= 2; },
                                    "a ratio h/a in [1, 2]");
       p.block     = r.lengths(s + "Block size");
       p.substrate = r.lengths(s + "Substrate size");
       p.periodic  = r.text(s + "Periodic") == "true";
-      p.pressure  = r.number(s + "Pressure", positive, "a positive pressure in Pa");
-      p.tau       = r.number(s + "Pressure ramp time", positive, "a positive ramp time tau in s");
-      p.velocity  = r.number(s + "Sliding velocity", non_negative, "a sliding velocity >= 0 in m/s");
-      p.slide_start = r.number(s + "Slide start", non_negative, "a start time >= 0 in s");
-      p.end_time = r.number("Simulation/End time", positive, "a positive end time in s");
-      p.gamma    = r.number(s + "Gamma", non_negative, "a damping rate gamma >= 0 in 1/s");
-      p.settling_gamma = r.number(s + "Settling gamma", non_negative, "a damping rate >= 0 in 1/s");
+      p.pressure  = r.number(s + "Pressure", is_positive, "a positive pressure in Pa");
+      p.tau       = r.number(s + "Pressure ramp time", is_positive, "a positive ramp time tau in s");
+      p.velocity  = r.number(s + "Sliding velocity", is_non_negative, "a sliding velocity >= 0 in m/s");
+      p.slide_start = r.number(s + "Slide start", is_non_negative, "a start time >= 0 in s");
+      p.end_time = r.number("Simulation/End time", is_positive, "a positive end time in s");
+      p.gamma    = r.number(s + "Gamma", is_non_negative, "a damping rate gamma >= 0 in 1/s");
+      p.settling_gamma = r.number(s + "Settling gamma", is_non_negative, "a damping rate >= 0 in 1/s");
       p.damping_to_sliding_velocity = r.text(s + "Damping reference") == "sliding velocity";
       p.driven_layers = static_cast<unsigned int>(r.integer(s + "Driven layers", 1, "an integer >= 1"));
       p.integration = read_integration(r, s);
-      p.stiffness_factor = r.number(s + "Boundary stiffness factor", positive, "a positive factor");
+      p.stiffness_factor = r.number(s + "Boundary stiffness factor", is_positive, "a positive factor");
       p.range_ratio = r.number(s + "Boundary range ratio", [](double v) { return v > 0 && v < 2; },
                                "a ratio d/a in (0, 2)");
       p.rest_on_tips = r.text(s + "Block rest") == "tips";
@@ -112,18 +112,18 @@ namespace tribo::app
                               "'tilted')");
       p.angle   = r.number(s + "Tilt angle", [](double v) { return v >= 0 && v <= 45; },
                            "an angle in degrees in [0, 45]") * M_PI / 180;
-      p.ratio   = r.number(s + "Mesh ratio", positive, "a positive ratio (golden mean 1.618...)");
+      p.ratio   = r.number(s + "Mesh ratio", is_positive, "a positive ratio (golden mean 1.618...)");
       p.hole_fraction = r.number(s + "Hole fraction", [](double v) { return v >= 0 && v < 1; },
                                  "a fraction in [0, 1)");
-      p.dz = r.number(s + "Roughness amplitude", non_negative, "a height >= 0 in m");
+      p.dz = r.number(s + "Roughness amplitude", is_non_negative, "a height >= 0 in m");
       p.fractal_dimension = r.number(s + "Fractal dimension", [&](double v) {
         return p.surface != Surface::fractal || (v > p.dim - 1.0 && v < p.dim);
       }, "D_f in (dim - 1, dim) for Surface = fractal");
-      p.step_position = r.number(s + "Step position", non_negative, "a position >= 0 in m");
+      p.step_position = r.number(s + "Step position", is_non_negative, "a position >= 0 in m");
       p.seed    = static_cast<std::uint64_t>(r.integer(s + "Seed", 0, "an integer >= 0"));
       p.regions = static_cast<unsigned int>(r.integer(s + "Local friction regions", 1, "an integer >= 1"));
-      p.statistics_interval = r.number(s + "Statistics interval", positive, "a positive interval in s");
-      p.field_interval = r.number(s + "Field interval", non_negative, "an interval >= 0 in s (0: first and last)");
+      p.statistics_interval = r.number(s + "Statistics interval", is_positive, "a positive interval in s");
+      p.field_interval = r.number(s + "Field interval", is_non_negative, "an interval >= 0 in s (0: first and last)");
       p.averaging_fraction = r.number(s + "Averaging fraction", [](double v) { return v > 0 && v <= 1; },
                                       "a fraction in (0, 1]");
       if (p.slide_start >= p.end_time)
