@@ -128,7 +128,6 @@ namespace tribo::dem
     /// deformable body, less its impulse_extra_power()): -P_c is what contact c dissipates.
     const std::vector<double> &contact_power() const { return power_of_contact; }
     const ContactLaw &law() const { return contact_law; }
-    const SolverParameters &solver_parameters() const { return solver->parameters(); }
     double theta() const { return th; }
     double detection_distance() const { return distance; }
     /// Steps of motion at the start velocity over which a pair beyond the detection

@@ -138,7 +138,9 @@ namespace tribo::dem
   /// What one solve achieved.
   struct SolveReport
   {
-    unsigned int iterations   = 0; ///< NLGS sweeps done (check passes not included)
+    /// The method's iterations, predictor sweeps included (check passes not included): NLGS
+    /// sweeps, or what the method's row in dem/solvers/methods.cc names.
+    unsigned int iterations   = 0;
     /// Active set: sparse factorisations done (Newton iterations), and whether it fell
     /// back to NLGS (which then reports its sweeps in iterations).
     unsigned int factorizations = 0;

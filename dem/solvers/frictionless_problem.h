@@ -20,7 +20,6 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
-#include <string>
 #include <vector>
 
 namespace tribo::dem
