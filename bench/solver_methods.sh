@@ -18,29 +18,21 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 tribo=${TRIBO:-$here/build/bin/tribo}
 [ $# -ge 3 ] || { echo "usage: $0 RUN_DIR STEPS SETTING [SETTING ...]" >&2; exit 2; }
 [ -f "$1/checkpoint.bin" ] || { echo "$0: $1: no checkpoint.bin" >&2; exit 2; }
-exec /usr/bin/python3 - "$tribo" "$@" <<'PY'
-import csv, json, os, re, shutil, subprocess, sys, tempfile
+exec /usr/bin/python3 - "$here/bench" "$tribo" "$@" <<'PY'
+import csv, json, os, re, shutil, sys, tempfile
 
 import numpy as np
 
-tribo, src, steps, settings = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
-# One core and the plain sweep unless a setting says otherwise (later --set entries win).
-fixed = ["Solver/Threads=1", "Solver/Streams=1", "Output/Field interval=0", "Output/Plots=false", "Output/Statistics interval=1",
-         "Output/Checkpoint interval=0", "Output/Checkpoint step interval=0"]
+sys.path.insert(0, sys.argv[1])
+from checkpoint_copies import entries, resume as resume_copy  # noqa: E402
+
+tribo, src, steps, settings = sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5:]
 
 
 def resume(end, dst, extra):
-    shutil.rmtree(dst, ignore_errors=True)
-    shutil.copytree(src, dst)
-    args = [tribo, "run", os.path.join(dst, "parameters.prm"), "--resume", dst, "--quiet"]
-    for s in fixed + ["Simulation/End time=%.17g" % end] + extra:
-        args += ["--set", s]
-    before = open(os.path.join(dst, "log.txt")).read().count("resumed at step")
-    run = subprocess.run(args, capture_output=True, text=True)  # a failed run is reported, not fatal
-    resumed = re.findall(r"resumed at step (\d+)", open(os.path.join(dst, "log.txt")).read())
-    if len(resumed) == before:
-        sys.exit(f"{src}: the checkpoint did not resume: {run.stderr.strip()[:300]}")
-    return int(resumed[-1]), json.load(open(os.path.join(dst, "summary.json")))
+    """The resumed step and the summary (a failed run is reported, not fatal)."""
+    step = resume_copy(tribo, src, dst, end, extra)
+    return step, json.load(open(os.path.join(dst, "summary.json")))
 
 
 prm = open(os.path.join(src, "parameters.prm")).read()
@@ -65,8 +57,7 @@ try:
           "| law residual mean / max | worst overlap / r_min | mu |")
     print("|---|---|---|---|---|---|---|---|---|")
     for setting in settings:
-        extra = [s.strip() for s in re.split(r"\s+(?=[A-Z][A-Za-z ]*/)", setting.strip()) if s.strip()]
-        _, s = resume((step0 + steps) * h, dst, extra)
+        _, s = resume((step0 + steps) * h, dst, entries(setting))
         rows = [r for r in csv.DictReader(open(os.path.join(dst, "statistics.csv")))
                 if int(float(r["step"])) > step0]
         if s["status"] != "complete":

@@ -22,28 +22,24 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 tribo=${TRIBO:-$here/build/bin/tribo}
 [ $# -ge 3 ] || { echo "usage: $0 RUN_DIR STEPS SETTING [SETTING ...]" >&2; exit 2; }
 [ -f "$1/checkpoint.bin" ] || { echo "$0: $1: no checkpoint.bin" >&2; exit 2; }
-exec /usr/bin/python3 - "$tribo" "$@" <<'PY'
-import csv, os, re, shutil, subprocess, sys, tempfile
+exec /usr/bin/python3 - "$here/bench" "$tribo" "$@" <<'PY'
+import csv, json, os, re, shutil, sys, tempfile
 
 import numpy as np
 
-tribo, src, steps, settings = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4:]
-fixed = ["Solver/Threads=1", "Solver/Streams=1", "Output/Field interval=0", "Output/Plots=false",
-         "Output/Statistics interval=1", "Output/Checkpoint interval=0",
-         "Output/Checkpoint step interval=0"]
+sys.path.insert(0, sys.argv[1])
+from checkpoint_copies import entries, resume as resume_copy  # noqa: E402
+
+tribo, src, steps, settings = sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5:]
 
 
 def resume(end, dst, extra):
-    shutil.rmtree(dst, ignore_errors=True)
-    shutil.copytree(src, dst)
-    args = [tribo, "run", os.path.join(dst, "parameters.prm"), "--resume", dst, "--quiet"]
-    for s in fixed + ["Simulation/End time=%.17g" % end] + extra:
-        args += ["--set", s]
-    run = subprocess.run(args, capture_output=True, text=True)
-    if run.returncode != 0:
-        sys.exit(f"{src}: {' '.join(extra)}: {run.stderr.strip()[:300]}")
-    resumed = re.findall(r"resumed at step (\d+)", open(os.path.join(dst, "log.txt")).read())
-    return int(resumed[-1])
+    """The resumed step; stops at a run that fails."""
+    step = resume_copy(tribo, src, dst, end, extra)
+    with open(os.path.join(dst, "summary.json")) as f:
+        if json.load(f)["status"] != "complete":
+            sys.exit(f"{src}: {' '.join(extra)}: the step did not complete (see {dst}/log.txt)")
+    return step
 
 
 def grains(run_dir):
@@ -69,8 +65,7 @@ try:
     print("|---|---|---|---|---|---|---|---|")
     reference = None
     for setting in settings:
-        extra = [s.strip() for s in re.split(r"\s+(?=[A-Z][A-Za-z ]*/)", setting.strip()) if s.strip()]
-        resume((step0 + steps) * h, dst, extra)
+        resume((step0 + steps) * h, dst, entries(setting))
         last = list(csv.DictReader(open(os.path.join(dst, "statistics.csv"))))[-1]
         v = grains(dst)
         if reference is None:

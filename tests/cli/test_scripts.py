@@ -155,5 +155,76 @@ class CompareFriction(TempDirTestCase):
                       "lower_wall_normal_force, max_overlap", r.stderr)
 
 
+def reproduction(*args):
+    return subprocess.run([sys.executable, os.path.join(SCRIPTS, "reproduction.py")] + list(args),
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, timeout=120)
+
+
+def write_reference(runs, sigma_yy, sigma_yy_stderr):
+    """A tradeoff_default study whose reference has the given sigma_yy (MPa), sigma_xy 11.5
+    +/- 0.1 MPa, a linear profile of 10 layers from V = 5 m/s to 0 and epsilon 6e-10 m (1e-3 of a 0.6 um radius)
+    before and 1.2e-10 m (2e-4 of it) in its averaging window."""
+    case = os.path.join(runs, "tradeoff_default", "case_000")
+    os.makedirs(case)
+    columns = {"case": "0", "knob": "reference", "value": "Solver/Method = interior-point", "status": "complete",
+               "mu_mean": "0.115", "mu_stderr": "0.001", "sigma_yy_mean": str(sigma_yy * 1e6),
+               "sigma_yy_stderr": str(sigma_yy_stderr * 1e6), "sigma_xy_mean": "11.5e6", "sigma_xy_stderr": "1e5",
+               "power_balance_ratio": "1.001", "power_balance_ratio_stderr": "0.005", "directory": "case_000"}
+    with open(os.path.join(runs, "tradeoff_default", "study_summary.csv"), "w") as f:
+        f.write(",".join(columns) + "\n" + ",".join(columns.values()) + "\n")
+    with open(os.path.join(case, "profiles.csv"), "w") as f:
+        f.write("layer,y_over_h,vx\n")
+        for i in range(10):
+            f.write("%d,%r,%r\n" % (i, (i + 0.5) / 10, 5 * (1 - (i + 0.5) / 10)))
+    with open(os.path.join(case, "summary.json"), "w") as f:
+        f.write('{"results": {"averaging_start": 1e-6}}')
+    with open(os.path.join(case, "parameters.prm"), "w") as f:
+        f.write("subsection SPH slider\n  set Sliding velocity = 1\nend\n"
+                "subsection Shear cell\n  set Sliding velocity = 5 # m/s\nend\n")
+    with open(os.path.join(case, "statistics.csv"), "w") as f:
+        f.write("time,epsilon\n")
+        for i in range(20):
+            f.write("%r,%r\n" % (i * 1e-7, 6e-10 if i < 10 else -1.2e-10))
+
+
+def reproduction_rows(stdout):
+    """{quantity: (ours, verdict)} of the table."""
+    rows = [line.split(" | ") for line in stdout.splitlines() if line.startswith("| ") and "---" not in line]
+    return {r[2]: (r[4], r[6].rstrip(" |")) for r in rows[1:]}
+
+
+class Reproduction(TempDirTestCase):
+    def test_verdicts_from_the_reference_run(self):
+        write_reference(self.tmp, 100.1, 0.1)
+        r = reproduction(self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = reproduction_rows(r.stdout)
+        self.assertEqual(rows["sigma_yy across the gap"], ("100.1 +/- 0.1 MPa", "reproduced"))
+        self.assertEqual(rows["power balance in steady state"][1], "reproduced")
+        self.assertEqual(rows["gap residue epsilon (IQS)"],
+                         ("mean abs(epsilon) = 2.0e-04 of the mean radius", "reproduced"))
+        ours, verdict = rows["velocity profile without cohesion, rigid walls"]
+        self.assertTrue(ours.startswith("rms deviation from a line 0.000 V; two layers at each wall carry 22% and 22%"),
+                        ours)
+        self.assertEqual(verdict, "reproduced")
+        self.assertTrue(rows["sigma_xy without cohesion (IQS, 100 MPa, 5 m/s)"][1]
+                        .startswith("not reproduced: 2.3 times the paper's"))
+        # the studies that are not there
+        self.assertEqual(rows["sigma_xy at gamma = 0.5"], ("not run", "not run"))
+
+    def test_a_load_two_errors_off_is_not_reproduced(self):
+        write_reference(self.tmp, 100.3, 0.1)
+        rows = reproduction_rows(reproduction(self.tmp).stdout)
+        self.assertEqual(rows["sigma_yy across the gap"][1], "not reproduced")
+
+    def test_without_runs_nothing_is_claimed(self):
+        r = reproduction(self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = reproduction_rows(r.stdout)
+        self.assertEqual(rows["sigma_yy across the gap"], ("not run", "not run"))
+        self.assertEqual(len(rows), 20)
+        self.assertEqual(reproduction(os.path.join(self.tmp, "missing")).returncode, 2)
+
+
 if __name__ == "__main__":
     main()
