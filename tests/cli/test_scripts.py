@@ -212,6 +212,21 @@ class Reproduction(TempDirTestCase):
         # the studies that are not there
         self.assertEqual(rows["sigma_xy at gamma = 0.5"], ("not run", "not run"))
 
+    def test_a_layer_that_does_not_move_is_called_a_plug(self):
+        write_reference(self.tmp, 100.0, 0.1)
+        case = os.path.join(self.tmp, "touching_walls", "case_000")
+        os.makedirs(case)
+        with open(os.path.join(self.tmp, "touching_walls", "study_summary.csv"), "w") as f:
+            f.write("case,Shear cell/Wall discs,status,sigma_xy_mean,sigma_xy_stderr,directory\n"
+                    "0,41,complete,6.3e6,1.5e5,case_000\n")
+        with open(os.path.join(case, "profiles.csv"), "w") as f:
+            f.write("layer,y_over_h,vx\n" + "".join("%d,%r,0.01\n" % (i, (i + 0.5) / 10) for i in range(10)))
+        with open(os.path.join(case, "parameters.prm"), "w") as f:
+            f.write("subsection Shear cell\n  set Sliding velocity = 5\nend\n")
+        verdict = reproduction_rows(reproduction(self.tmp).stdout)["sigma_xy without cohesion (IQS, 100 MPa, 5 m/s)"][1]
+        self.assertIn("walls of touching 0.96 um discs give 6.3 +/- 0.15 MPa, with the layer a plug that the lower "
+                      "wall slides under", verdict)
+
     def test_a_load_two_errors_off_is_not_reproduced(self):
         write_reference(self.tmp, 100.3, 0.1)
         rows = reproduction_rows(reproduction(self.tmp).stdout)
