@@ -134,9 +134,16 @@ def cohesion_row(gamma, paper_mpa):
             return None
         a = float(near["sigma_xy_mean"]) / MPA
         b = float(far["sigma_xy_mean"]) / MPA
-        return (f"{pm(near['sigma_xy_mean'], near['sigma_xy_stderr'], MPA)} MPa at eta = "
+        ours = (f"{pm(near['sigma_xy_mean'], near['sigma_xy_stderr'], MPA)} MPa at eta = "
                 f"{int(eta) // 120}, d_w = 0.02 d; {pm(far['sigma_xy_mean'], far['sigma_xy_stderr'], MPA)} MPa "
-                f"at eta = {int(wide) // 120}, d_w = 0.2 d",
+                f"at eta = {int(wide) // 120}, d_w = 0.2 d")
+        paper_size = case_where(study(runs, "cohesion_paper"), Contact_law__Cohesion=eta)
+        if paper_size is not None and paper_size["sigma_xy_mean"]:
+            ours += (f"; at the paper's size, eta = {int(eta) // 120} and 0.02 d: "
+                     f"{pm(paper_size['sigma_xy_mean'], paper_size['sigma_xy_stderr'], MPA)} MPa"
+                     + ("" if paper_size["status"] == "complete" else
+                        " (the run stopped before its end: " + paper_size["error"][:60] + "...)"))
+        return (ours,
                 f"reproduced under a reading (gamma = {gamma} as eta = {int(eta) // 120} with d_w = 0.02 d, "
                 f"{a / paper_mpa - 1:+.0%}; or eta = {int(wide) // 120} with d_w = 0.2 d, {b / paper_mpa - 1:+.0%}); "
                 "read as N/m (eta = 0.004-0.008) it changes nothing: not reproduced")
@@ -222,7 +229,8 @@ ROWS = [
      "build/bin/tribo study cases/reproduction/touching_walls.prm --output RUNS/touching_walls",
      row_sigma_xy_without_cohesion),
     (CAO, "Fig. 10", "sigma_xy at gamma = 0.5", "32 MPa",
-     "mpirun -np 2 build/bin/tribo study cases/shear/cohesion_sweep.prm --output RUNS/cohesion_sweep",
+     "mpirun -np 2 build/bin/tribo study cases/shear/cohesion_sweep.prm --output RUNS/cohesion_sweep; "
+     "mpirun -np 2 build/bin/tribo study cases/reproduction/cohesion_paper.prm --output RUNS/cohesion_paper",
      cohesion_row(0.5, 32.0)),
     (CAO, "Fig. 10", "sigma_xy at gamma = 1", "50 MPa", "(the same study)", cohesion_row(1.0, 50.0)),
     (CAO, "Fig. 10", "sigma_xy ratio on doubling gamma (0.5 -> 1)", "50 / 32 = 1.56", "(the same study)",
