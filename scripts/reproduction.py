@@ -3,14 +3,16 @@
 ours +/- its standard error, the run that made it and the verdict, rebuilt from the runs'
 outputs.
 
-    /usr/bin/python3 scripts/reproduction.py RUNS > docs/reproduction.md
+    /usr/bin/python3 scripts/reproduction.py RUNS docs/reproduction.md
 
 RUNS holds the output directories of the commands the table names, under the names those
 commands give them (RUNS/tradeoff_default for `--output output/tradeoff_default`, ...).
 A row whose run is not there says "not run"; a row that no run of this script settles
 yet says where its current figure is and "not settled by a run". Each computed row reads
 the study's study_summary.csv, a case's summary.json, statistics.csv and profiles.csv
-(docs/outputs.md). Exit code 2 when RUNS is not a directory.
+(docs/outputs.md). OUTPUT is replaced whole, only once every row is read; without it the
+table goes to standard output. Exit code 2, naming the row and the file, when RUNS is not
+a directory or a run's output cannot be read (OUTPUT then stays as it was).
 
 A figure is "reproduced" when it lies within two standard errors of the paper's value or,
 for a paper's qualitative statement, when the measured quantity meets it; "reproduced
@@ -292,21 +294,33 @@ ROWS = [
 
 
 def main(argv):
-    if len(argv) != 2 or not os.path.isdir(argv[1]):
-        sys.stderr.write("usage: reproduction.py RUNS (a directory of run outputs)\n")
+    if len(argv) not in (2, 3) or not os.path.isdir(argv[1]):
+        sys.stderr.write("usage: reproduction.py RUNS [OUTPUT] (RUNS: a directory of run outputs)\n")
         return 2
     runs = argv[1]
-    print("# The seed papers' figures, reproduced or not\n")
-    print("Rebuilt by `/usr/bin/python3 scripts/reproduction.py RUNS > docs/reproduction.md` from the")
-    print("outputs of the commands in the table (RUNS/NAME for `--output RUNS/NAME`); every figure")
-    print("is mean +/- batch-means standard error. Rows that no run of this table settles yet give")
-    print("their current figure and where it is documented.\n")
-    print("| paper | figure | quantity | paper | ours | run | verdict |")
-    print("|---|---|---|---|---|---|---|")
+    lines = ["# The seed papers' figures, reproduced or not", "",
+             "Rebuilt by `/usr/bin/python3 scripts/reproduction.py RUNS docs/reproduction.md` from the",
+             "outputs of the commands in the table (RUNS/NAME for `--output RUNS/NAME`); every figure",
+             "is mean +/- batch-means standard error. Rows that no run of this table settles yet give",
+             "their current figure and where it is documented.", "",
+             "| paper | figure | quantity | paper | ours | run | verdict |",
+             "|---|---|---|---|---|---|---|"]
     for paper, figure, quantity, value, command, compute in ROWS:
-        result = compute(runs)
+        try:
+            result = compute(runs)
+        except (OSError, KeyError, ValueError, AttributeError, IndexError) as e:
+            sys.stderr.write(f"reproduction.py: {runs}: the row '{quantity}' cannot be read: "
+                             f"{type(e).__name__}: {e}\n")
+            return 2
         ours, verdict = result if result is not None else ("not run", "not run")
-        print(f"| {paper} | {figure} | {quantity} | {value} | {ours} | `{command}` | {verdict} |")
+        lines.append(f"| {paper} | {figure} | {quantity} | {value} | {ours} | `{command}` | {verdict} |")
+    text = "\n".join(lines) + "\n"
+    if len(argv) == 2:
+        sys.stdout.write(text)
+    else:  # written whole or not at all: a failed rebuild leaves the last table as it was
+        with open(argv[2] + ".tmp", "w") as f:
+            f.write(text)
+        os.replace(argv[2] + ".tmp", argv[2])
     return 0
 
 

@@ -163,6 +163,9 @@ namespace tribo::app
         j.set("sliding", sliding);
         // Averaging window: the steady state when sliding, else the last fifth (compaction).
         double start = time.front() + 0.8 * (t1 - time.front());
+        // The upper body's mean vertical velocity just before Shear start (0 before the shear).
+        const double landing =
+          sliding ? vy_before_shear(time, stats.column("upper_wall_vy"), k.shear_start) : 0.0;
         if (sliding)
           {
             steady = detect_steady_state(time, {stats.column("mu"), stats.column("kinetic_energy")},
@@ -171,7 +174,7 @@ namespace tribo::app
             j.set("steady_state_reached", steady.reached);
             j.set("steady_state_start", steady.start);
             j.set("upper_body_vy_at_shear_start", vy_at_shear_start);
-            j.set("upper_body_vy_before_shear", vy_before_shear(time, stats.column("upper_wall_vy"), k.shear_start));
+            j.set("upper_body_vy_before_shear", landing);
           }
         else
           steady.start = t1 + 1; // no profile sample is in a steady state
@@ -199,8 +202,6 @@ namespace tribo::app
           if (sliding)
             note << "; " << profiles->n_samples_after(steady.start) << " profile samples of " << block_steps
                  << " steps each";
-          const double landing =
-            sliding ? vy_before_shear(time, stats.column("upper_wall_vy"), k.shear_start) : 0.0;
           if (std::abs(landing) > still_moving * std::abs(k.sliding_velocity))
             note << ". Over the last microsecond before Shear start the upper body was still moving at "
                  << landing << " m/s on average (more than " << 100 * still_moving

@@ -232,6 +232,28 @@ class Reproduction(TempDirTestCase):
         rows = reproduction_rows(reproduction(self.tmp).stdout)
         self.assertEqual(rows["sigma_yy across the gap"][1], "not reproduced")
 
+    def test_an_unreadable_run_names_its_row_and_keeps_the_table(self):
+        write_reference(self.tmp, 100.0, 0.1)
+        os.remove(os.path.join(self.tmp, "tradeoff_default", "case_000", "profiles.csv"))
+        table = os.path.join(self.tmp, "reproduction.md")
+        with open(table, "w") as f:
+            f.write("the last table\n")
+        r = reproduction(self.tmp, table)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("the row 'velocity profile without cohesion, rigid walls' cannot be read: "
+                      "FileNotFoundError", r.stderr)
+        self.assertIn(os.path.join("case_000", "profiles.csv"), r.stderr)
+        with open(table) as f:
+            self.assertEqual(f.read(), "the last table\n")
+        self.assertFalse(os.path.exists(table + ".tmp"))
+
+    def test_the_output_file_holds_the_table(self):
+        write_reference(self.tmp, 100.1, 0.1)
+        table = os.path.join(self.tmp, "reproduction.md")
+        self.assertEqual(reproduction(self.tmp, table).returncode, 0)
+        with open(table) as f:
+            self.assertEqual(reproduction_rows(f.read())["sigma_yy across the gap"], ("100.1 +/- 0.1 MPa", "reproduced"))
+
     def test_without_runs_nothing_is_claimed(self):
         r = reproduction(self.tmp)
         self.assertEqual(r.returncode, 0, r.stderr)
