@@ -1,5 +1,7 @@
 #include "core/run_control.h"
 
+#include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 
@@ -27,11 +29,42 @@ namespace tribo
     return q + "'";
   }
 
+  RecentRate::RecentRate(double window)
+    : window(window)
+  {}
+
+  void RecentRate::add(double wall, double time, unsigned long step)
+  {
+    const double dw = wall - last_wall;
+    if (started && dw > 0)
+      {
+        const double dt_rate = (time - last_time) / dw;
+        const double ds_rate = (static_cast<double>(step) - static_cast<double>(last_step)) / dw;
+        const bool   first   = time_rate == 0 && step_rate == 0;
+        const double weight  = first ? 1.0 : 1.0 - std::exp(-dw / window);
+        time_rate += weight * (dt_rate - time_rate);
+        step_rate += weight * (ds_rate - step_rate);
+      }
+    if (!started || dw > 0)
+      {
+        started   = true;
+        last_wall = wall;
+        last_time = time;
+        last_step = step;
+      }
+  }
+
+  double RecentRate::seconds_to(double end_time) const
+  {
+    return time_rate > 0 ? std::max(0.0, end_time - last_time) / time_rate : -1.0;
+  }
+
   ProgressLine::ProgressLine(double end_time, bool enabled)
     : end_time(end_time)
     , enabled(enabled)
     , start(Clock::now())
     , last(start)
+    , pace(10.0)
   {}
 
   void ProgressLine::update(double time, unsigned long step)
@@ -41,13 +74,15 @@ namespace tribo
     const auto now = Clock::now();
     if (std::chrono::duration<double>(now - last).count() < 0.25)
       return;
-    last                 = now;
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    const double frac    = end_time > 0 ? time / end_time : 0;
-    const double rate    = elapsed > 0 ? step / elapsed : 0;
-    const double eta     = frac > 0 ? elapsed * (1 - frac) / frac : 0;
-    std::fprintf(stderr, "\rprogress %5.1f %%  t = %.4g s  %.4g steps/s  ETA %.0f s   ",
-                 100 * frac, time, rate, eta);
+    last = now;
+    pace.add(std::chrono::duration<double>(now - start).count(), time, step);
+    const double frac = end_time > 0 ? time / end_time : 0;
+    const double eta  = pace.seconds_to(end_time);
+    char         rate[32] = "-";
+    if (eta >= 0)
+      std::snprintf(rate, sizeof rate, "%.4g", pace.steps_per_second());
+    std::fprintf(stderr, "\rprogress %5.1f %%  t = %.4g s  %s steps/s  ETA %s   ", 100 * frac, time, rate,
+                 eta < 0 ? "-" : (std::to_string(static_cast<long>(eta + 0.5)) + " s").c_str());
     std::fflush(stderr);
     printed = true;
   }
