@@ -164,218 +164,253 @@ namespace tribo::app
           return *v == "null" ? "" : *v;
       return "";
     }
-  } // namespace
 
-  int run_study(const StudyOptions &o)
-  {
-    // The study file: base case, varied and fixed entries.
-    dealii::ParameterHandler prm;
-    prm.enter_subsection("Study");
-    prm.declare_entry("Base case", "", dealii::Patterns::Anything(),
-                      "The case file every combination starts from (relative to the study file).");
-    prm.declare_entry("Parameters", "", dealii::Patterns::Anything(),
-                      "Varied entries: \"Subsection/Entry = v1, v2, ...; Subsection/Entry = ...\".");
-    prm.declare_entry("Fixed", "", dealii::Patterns::Anything(),
-                      "Overrides for every case: \"Subsection/Entry = value; ...\".");
-    prm.declare_entry("Design", "combinations", dealii::Patterns::Selection("combinations|tradeoff"),
-                      "'combinations': every combination of the Parameters lists; 'tradeoff': the "
-                      "Reference case, then each Parameters list as a ladder varied alone from the base "
-                      "case, with cost and error against the Reference (scripts/tradeoff.py).");
-    prm.declare_entry("Shear-phase entries", "", dealii::Patterns::Anything(),
-                      "Entries (\"Subsection/Entry; ...\") the study applies from Shear start on only: the "
-                      "shared compaction runs with the base case's values of them (e.g. Contact "
-                      "law/Cohesion for a study of cohesion in shear from one compacted sample).");
-    prm.declare_entry("Share compaction", "true", dealii::Patterns::Bool(),
-                      "Shear cases that differ only in entries acting after Shear start (End time, "
-                      "Sliding velocity, Profile samples, Layer thickness, Output/*, the Shear-phase "
-                      "entries) run their compaction once and shear from its state (Shear cell/Initial "
-                      "state, docs/outputs.md 'Studies').");
-    prm.declare_entry("Reference", "", dealii::Patterns::Anything(),
-                      "Design = tradeoff: the finest setting, \"Subsection/Entry = value; ...\" (each "
-                      "entry one of the Parameters).");
-    prm.leave_subsection();
-    ParameterFile file(prm);
-    file.parse(o.study_file);
-    const fs::path base = fs::path(o.study_file).parent_path() / file.get("Study/Base case");
-    if (file.get("Study/Base case").empty() || !fs::is_regular_file(base))
-      throw InputError(file.where("Study/Base case") + ": entry 'Study/Base case' = '" +
-                       file.get("Study/Base case") + "': expected an existing case file (" +
-                       base.string() + " not found)");
-    const auto axes  = parse_axes(file.get("Study/Parameters"), file.where("Study/Parameters"));
-    const auto fixed = parse_axes(file.get("Study/Fixed"), file.where("Study/Fixed"));
-    for (const auto &f : fixed)
-      if (f.values.size() != 1)
-        throw InputError(file.where("Study/Fixed") + ": '" + f.path + "' has several values: vary it in Parameters");
+    /// A study file, read and checked: the base case, the varied, fixed and reference
+    /// entries, and how compactions are shared.
+    struct StudyDefinition
+    {
+      fs::path                 base;
+      std::vector<Axis>        axes, fixed, reference;
+      bool                     tradeoff = false, share_compaction = true;
+      std::vector<std::string> shear_phase;
+    };
 
-    const bool tradeoff = file.get("Study/Design") == "tradeoff";
-    if (o.require_tradeoff && !tradeoff)
-      throw InputError(file.where("Study/Design") + ": entry 'Study/Design' = '" + file.get("Study/Design") +
-                       "': expected 'tradeoff' for `tribo tradeoff` (or run the file with `tribo study`)");
-    const auto reference = parse_axes(file.get("Study/Reference"), file.where("Study/Reference"));
+    /// Declare, parse and check the Study subsection of @p o.study_file (errors name the
+    /// file, line and entry).
+    StudyDefinition read_study(const StudyOptions &o)
+    {
+      dealii::ParameterHandler prm;
+      prm.enter_subsection("Study");
+      prm.declare_entry("Base case", "", dealii::Patterns::Anything(),
+                        "The case file every combination starts from (relative to the study file).");
+      prm.declare_entry("Parameters", "", dealii::Patterns::Anything(),
+                        "Varied entries: \"Subsection/Entry = v1, v2, ...; Subsection/Entry = ...\".");
+      prm.declare_entry("Fixed", "", dealii::Patterns::Anything(),
+                        "Overrides for every case: \"Subsection/Entry = value; ...\".");
+      prm.declare_entry("Design", "combinations", dealii::Patterns::Selection("combinations|tradeoff"),
+                        "'combinations': every combination of the Parameters lists; 'tradeoff': the "
+                        "Reference case, then each Parameters list as a ladder varied alone from the base "
+                        "case, with cost and error against the Reference (scripts/tradeoff.py).");
+      prm.declare_entry("Shear-phase entries", "", dealii::Patterns::Anything(),
+                        "Entries (\"Subsection/Entry; ...\") the study applies from Shear start on only: the "
+                        "shared compaction runs with the base case's values of them (e.g. Contact "
+                        "law/Cohesion for a study of cohesion in shear from one compacted sample).");
+      prm.declare_entry("Share compaction", "true", dealii::Patterns::Bool(),
+                        "Shear cases that differ only in entries acting after Shear start (End time, "
+                        "Sliding velocity, Profile samples, Layer thickness, Output/*, the Shear-phase "
+                        "entries) run their compaction once and shear from its state (Shear cell/Initial "
+                        "state, docs/outputs.md 'Studies').");
+      prm.declare_entry("Reference", "", dealii::Patterns::Anything(),
+                        "Design = tradeoff: the finest setting, \"Subsection/Entry = value; ...\" (each "
+                        "entry one of the Parameters).");
+      prm.leave_subsection();
+      ParameterFile file(prm);
+      file.parse(o.study_file);
 
-    // The cases, as --set overrides, and what the table shows of each (its columns).
-    std::vector<std::vector<std::string>> cases, columns;
-    std::vector<std::string>              headers;
-    std::vector<std::string>              common;
-    for (const auto &f : fixed)
-      common.push_back(f.path + "=" + f.values[0]);
-    if (!tradeoff)
-      {
-        // Every combination, last axis fastest.
-        cases   = {common};
-        columns = {{}};
-        for (const auto &a : axes)
-          {
-            headers.push_back(a.path);
-            std::vector<std::vector<std::string>> next, next_columns;
-            for (std::size_t c = 0; c < cases.size(); ++c)
-              for (const auto &v : a.values)
-                {
-                  next.push_back(cases[c]);
-                  next.back().push_back(a.path + "=" + v);
-                  next_columns.push_back(columns[c]);
-                  next_columns.back().push_back(v);
-                }
-            cases   = next;
-            columns = next_columns;
-          }
-      }
-    else
-      {
-        // The reference first, then each ladder alone (a rung equal to the reference is
-        // not run twice).
-        if (reference.empty() || axes.empty())
-          throw InputError(file.where("Study/Reference") + ": a tradeoff needs Parameters (the ladders) and "
-                           "Reference (the finest setting of each)");
-        std::string reference_text;
-        cases = {common};
-        for (const auto &r : reference)
-          {
-            if (r.values.size() != 1)
-              throw InputError(file.where("Study/Reference") + ": '" + r.path + "' has several values: the "
-                               "reference is one setting");
-            if (std::none_of(axes.begin(), axes.end(), [&](const Axis &a) { return a.path == r.path; }))
-              throw InputError(file.where("Study/Reference") + ": '" + r.path + "' is not one of the "
-                               "Parameters (the ladders)");
-            cases[0].push_back(r.path + "=" + r.values[0]);
-            reference_text += (reference_text.empty() ? "" : "; ") + r.path + " = " + r.values[0];
-          }
-        headers = {"knob", "value"};
-        columns = {{"reference", reference_text}};
-        for (const auto &a : axes)
-          for (const auto &v : a.values)
+      StudyDefinition study;
+      study.base = fs::path(o.study_file).parent_path() / file.get("Study/Base case");
+      if (file.get("Study/Base case").empty() || !fs::is_regular_file(study.base))
+        throw InputError(file.where("Study/Base case") + ": entry 'Study/Base case' = '" +
+                         file.get("Study/Base case") + "': expected an existing case file (" +
+                         study.base.string() + " not found)");
+      study.axes  = parse_axes(file.get("Study/Parameters"), file.where("Study/Parameters"));
+      study.fixed = parse_axes(file.get("Study/Fixed"), file.where("Study/Fixed"));
+      for (const auto &f : study.fixed)
+        if (f.values.size() != 1)
+          throw InputError(file.where("Study/Fixed") + ": '" + f.path + "' has several values: vary it in Parameters");
+
+      study.tradeoff = file.get("Study/Design") == "tradeoff";
+      if (o.require_tradeoff && !study.tradeoff)
+        throw InputError(file.where("Study/Design") + ": entry 'Study/Design' = '" + file.get("Study/Design") +
+                         "': expected 'tradeoff' for `tribo tradeoff` (or run the file with `tribo study`)");
+      study.reference = parse_axes(file.get("Study/Reference"), file.where("Study/Reference"));
+      if (study.tradeoff)
+        {
+          if (study.reference.empty() || study.axes.empty())
+            throw InputError(file.where("Study/Reference") + ": a tradeoff needs Parameters (the ladders) and "
+                             "Reference (the finest setting of each)");
+          for (const auto &r : study.reference)
             {
-              auto c = common;
-              c.push_back(a.path + "=" + v);
-              if (c == cases[0])
-                continue;
-              cases.push_back(c);
-              columns.push_back({a.path, v});
+              if (r.values.size() != 1)
+                throw InputError(file.where("Study/Reference") + ": '" + r.path + "' has several values: the "
+                                 "reference is one setting");
+              if (std::none_of(study.axes.begin(), study.axes.end(), [&](const Axis &a) { return a.path == r.path; }))
+                throw InputError(file.where("Study/Reference") + ": '" + r.path + "' is not one of the "
+                                 "Parameters (the ladders)");
             }
-      }
+        }
 
-    // Check every combination before running any (bad input fails fast, exit 2).
-    const auto check_case = [&](const std::vector<std::string> &overrides) {
+      study.shear_phase      = split(file.get("Study/Shear-phase entries"), ';');
+      study.share_compaction = file.get_bool("Study/Share compaction");
+      for (const auto &e : study.shear_phase)
+        {
+          dealii::ParameterHandler check;
+          declare_case_parameters(check);
+          ParameterFile entries(check);
+          try
+            {
+              entries.get(e);
+            }
+          catch (const std::exception &)
+            {
+              throw InputError(file.where("Study/Shear-phase entries") + ": '" + e +
+                               "' is not an entry of a case (expected \"Subsection/Entry; ...\")");
+            }
+        }
+      return study;
+    }
+
+    /// The cases of a study as --set overrides, and what its table shows of each.
+    struct CaseList
+    {
+      std::vector<std::vector<std::string>> overrides, columns;
+      std::vector<std::string>              headers;
+    };
+
+    /// The Fixed entries as overrides.
+    std::vector<std::string> fixed_overrides(const StudyDefinition &study)
+    {
+      std::vector<std::string> common;
+      for (const auto &f : study.fixed)
+        common.push_back(f.path + "=" + f.values[0]);
+      return common;
+    }
+
+    /// Every combination of the Parameters lists, the last one varying fastest.
+    CaseList every_combination(const StudyDefinition &study)
+    {
+      CaseList list;
+      list.overrides = {fixed_overrides(study)};
+      list.columns   = {{}};
+      for (const auto &a : study.axes)
+        {
+          list.headers.push_back(a.path);
+          std::vector<std::vector<std::string>> next, next_columns;
+          for (std::size_t c = 0; c < list.overrides.size(); ++c)
+            for (const auto &v : a.values)
+              {
+                next.push_back(list.overrides[c]);
+                next.back().push_back(a.path + "=" + v);
+                next_columns.push_back(list.columns[c]);
+                next_columns.back().push_back(v);
+              }
+          list.overrides = next;
+          list.columns   = next_columns;
+        }
+      return list;
+    }
+
+    /// A tradeoff: the reference first, then each ladder alone (a rung equal to the
+    /// reference is not run twice).
+    CaseList reference_and_ladders(const StudyDefinition &study)
+    {
+      const auto  common = fixed_overrides(study);
+      CaseList    list;
+      std::string reference_text;
+      list.overrides = {common};
+      for (const auto &r : study.reference)
+        {
+          list.overrides[0].push_back(r.path + "=" + r.values[0]);
+          reference_text += (reference_text.empty() ? "" : "; ") + r.path + " = " + r.values[0];
+        }
+      list.headers = {"knob", "value"};
+      list.columns = {{"reference", reference_text}};
+      for (const auto &a : study.axes)
+        for (const auto &v : a.values)
+          {
+            auto c = common;
+            c.push_back(a.path + "=" + v);
+            if (c == list.overrides[0])
+              continue;
+            list.overrides.push_back(c);
+            list.columns.push_back({a.path, v});
+          }
+      return list;
+    }
+
+    /// The compactions the cases share: each distinct one as overrides, which one each
+    /// case starts from (-1: its own), and a sentence for the table.
+    struct SharedCompactions
+    {
+      std::vector<std::vector<std::string>> preparations;
+      std::vector<int>                      of_case;
+      std::string                           note;
+    };
+
+    /// One compaction per distinct preparation, when the cases share one (a tradeoff's
+    /// ladders judge the whole run, compaction included: they never share).
+    SharedCompactions shared_compactions(const StudyDefinition &study, const CaseList &list)
+    {
+      SharedCompactions shared;
+      shared.of_case.assign(list.overrides.size(), -1);
+      if (study.tradeoff || !study.share_compaction)
+        {
+          shared.note = study.tradeoff ? "no shared compaction: a tradeoff measures whole runs"
+                                       : "no shared compaction: Study/Share compaction = false";
+          return shared;
+        }
+      std::map<std::vector<std::string>, int> index;
+      bool                                    all = true;
+      for (std::size_t i = 0; i < list.overrides.size() && all; ++i)
+        {
+          const auto prep = preparation_of(study.base, list.overrides[i], study.shear_phase);
+          all             = !prep.empty();
+          if (all && !index.count(prep))
+            {
+              index[prep] = int(shared.preparations.size());
+              shared.preparations.push_back(prep);
+            }
+          shared.of_case[i] = all ? index[prep] : -1;
+        }
+      if (!all || shared.preparations.size() == list.overrides.size())
+        {
+          shared.note = !all ? "no shared compaction: not every case is a shear case with a rigid-wall "
+                               "compaction (0 < Shear start < End time) and no initial state"
+                             : "no shared compaction: every case compacts differently";
+          shared.preparations.clear();
+          std::fill(shared.of_case.begin(), shared.of_case.end(), -1);
+        }
+      else
+        shared.note = std::to_string(list.overrides.size()) + " cases shear from " +
+                      std::to_string(shared.preparations.size()) + " shared compaction" +
+                      (shared.preparations.size() > 1 ? "s" : "") +
+                      " (preparation_NNN/, Shear cell/Initial state): they differ only in entries that act "
+                      "after Shear start" + (study.shear_phase.empty() ? "" : " or in the Shear-phase entries");
+      return shared;
+    }
+
+    /// Check one case of @p base with @p overrides without running it (bad input fails
+    /// fast, exit 2).
+    void check_case(const fs::path &base, const std::vector<std::string> &overrides)
+    {
       RunOptions check;
       check.case_file  = base.string();
       check.overrides  = overrides;
       check.check_only = true;
       check.quiet      = true;
       run_case(check);
-    };
-    for (const auto &c : cases)
-      check_case(c);
+    }
 
-    // One compaction per distinct preparation, when cases share one (a tradeoff's ladders
-    // judge the whole run, compaction included: they never share).
-    const std::vector<std::string> shear_phase = split(file.get("Study/Shear-phase entries"), ';');
-    for (const auto &e : shear_phase)
-      {
-        dealii::ParameterHandler check;
-        declare_case_parameters(check);
-        ParameterFile entries(check);
-        try
-          {
-            entries.get(e);
-          }
-        catch (const std::exception &)
-          {
-            throw InputError(file.where("Study/Shear-phase entries") + ": '" + e +
-                             "' is not an entry of a case (expected \"Subsection/Entry; ...\")");
-          }
-      }
-    std::vector<std::vector<std::string>> preparations; ///< distinct, as overrides
-    std::vector<int>                      preparation_of_case(cases.size(), -1);
-    std::string                           sharing_note;
-    if (!tradeoff && file.get_bool("Study/Share compaction"))
-      {
-        std::map<std::vector<std::string>, int> index;
-        bool                                    all = true;
-        for (std::size_t i = 0; i < cases.size() && all; ++i)
-          {
-            const auto prep = preparation_of(base, cases[i], shear_phase);
-            all             = !prep.empty();
-            if (all && !index.count(prep))
-              {
-                index[prep] = int(preparations.size());
-                preparations.push_back(prep);
-              }
-            preparation_of_case[i] = all ? index[prep] : -1;
-          }
-        if (!all || preparations.size() == cases.size())
-          {
-            sharing_note = !all ? "no shared compaction: not every case is a shear case with a rigid-wall "
-                                  "compaction (0 < Shear start < End time) and no initial state"
-                                : "no shared compaction: every case compacts differently";
-            preparations.clear();
-            std::fill(preparation_of_case.begin(), preparation_of_case.end(), -1);
-          }
-        else
-          sharing_note = std::to_string(cases.size()) + " cases shear from " + std::to_string(preparations.size()) +
-                         " shared compaction" + (preparations.size() > 1 ? "s" : "") +
-                         " (preparation_NNN/, Shear cell/Initial state): they differ only in entries that act "
-                         "after Shear start" + (shear_phase.empty() ? "" : " or in the Shear-phase entries");
-      }
-    else
-      sharing_note = tradeoff ? "no shared compaction: a tradeoff measures whole runs"
-                              : "no shared compaction: Study/Share compaction = false";
-    for (const auto &prep : preparations)
-      check_case(prep);
-
-    const fs::path dir = o.output_dir.empty() ? fs::path("output") / fs::path(o.study_file).stem()
-                                              : fs::path(o.output_dir);
-    const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
-    const unsigned int size = dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
-    if (rank == 0)
-      fs::create_directories(dir);
-    MPI_Barrier(MPI_COMM_WORLD);
-
-    const auto numbered_dir = [&](const char *stem, std::size_t i) {
+    /// OUTPUT/STEM_NNN.
+    fs::path numbered_dir(const fs::path &dir, const char *stem, std::size_t i)
+    {
       char name[48];
       std::snprintf(name, sizeof name, "%s_%03zu", stem, i);
       return dir / name;
-    };
-    const auto case_dir = [&](std::size_t i) { return numbered_dir("case", i); };
-    // A case sharing a compaction starts from its state.
-    for (std::size_t i = 0; i < cases.size(); ++i)
-      if (preparation_of_case[i] >= 0)
-        cases[i].push_back("Shear cell/Initial state=" +
-                           fs::absolute(numbered_dir("preparation", preparation_of_case[i])).string());
-    const auto overrides_text = [&](const std::vector<std::string> &overrides) {
-      std::string s = "# tribo study: base case " + base.string() + "\n";
-      for (const auto &a : overrides)
-        s += a + "\n";
-      return s;
-    };
+    }
 
-    // Run one case (or preparation) into @p cd, or skip it when complete with the same
-    // overrides, or resume it from its checkpoint; false when interrupted by a signal.
-    const auto run_in = [&](const fs::path &cd, const std::vector<std::string> &overrides,
-                            const std::string &label) {
-      const std::string text = overrides_text(overrides);
+    /// Run one case (or preparation) of @p base into @p cd, or skip it when complete with
+    /// the same overrides, or resume it from its checkpoint; false when interrupted by a
+    /// signal.
+    bool run_into(const fs::path &cd, const fs::path &base, const std::vector<std::string> &overrides,
+                  const std::string &label, bool quiet)
+    {
+      std::string text = "# tribo study: base case " + base.string() + "\n";
+      for (const auto &a : overrides)
+        text += a + "\n";
       if (fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == text && run_status(cd.string()) == "complete")
         {
-          if (!o.quiet)
+          if (!quiet)
             std::cout << label << ": complete, skipped" << std::endl;
           return true;
         }
@@ -389,8 +424,9 @@ namespace tribo::app
       run.overrides = overrides;
       (resume ? run.resume_dir : run.output_dir) = cd.string();
       run.quiet = true;
-      if (!o.quiet)
-        std::cout << label << " (rank " << rank << "): " << (resume ? "resuming" : "running") << std::endl;
+      if (!quiet)
+        std::cout << label << " (rank " << dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD)
+                  << "): " << (resume ? "resuming" : "running") << std::endl;
       try
         {
           run_case(run);
@@ -403,7 +439,7 @@ namespace tribo::app
           failed.set("error", e.what());
           atomic_write((cd / "summary.json").string(), failed.to_string());
         }
-      if (!o.quiet)
+      if (!quiet)
         std::cout << label << ": " << run_status(cd.string()) << std::endl;
       if (stop_requested())
         {
@@ -413,114 +449,148 @@ namespace tribo::app
           return false;
         }
       return true;
-    };
+    }
+
+    /// study_summary.csv and .md from every case's summary.json: a time-averaged figure
+    /// with its batch-means standard error (the next key), written "mean +/- stderr" in the
+    /// .md. Returns the number of cases not complete.
+    unsigned int write_study_table(const fs::path &dir, const CaseList &list, const SharedCompactions &shared)
+    {
+      const std::vector<std::string> keys = {
+        "status", "mu_mean", "mu_stderr", "mu_std", "power_balance_ratio", "power_balance_ratio_stderr",
+        "power_lower_wall_mean", "power_dissipated_mean", "normal_force_mean", "normal_force_stderr",
+        "sigma_xx_mean", "sigma_xx_stderr", "sigma_yy_mean", "sigma_yy_stderr", "sigma_xy_mean",
+        "sigma_xy_stderr", "inertial_number", "cohesion_number", "steady_state_reached", "wall_time", "error"};
+      const auto is_stderr = [](const std::string &k) { return k.size() > 7 && k.substr(k.size() - 7) == "_stderr"; };
+      std::ostringstream csv, md;
+      csv << "case";
+      md << "| case";
+      for (const auto &h : list.headers)
+        {
+          csv << ",\"" << h << "\"";
+          md << " | " << h;
+        }
+      unsigned int md_columns = 0;
+      for (const auto &k : keys)
+        {
+          csv << "," << k;
+          if (!is_stderr(k))
+            {
+              md << " | " << k;
+              ++md_columns;
+            }
+        }
+      csv << ",preparation,directory\n";
+      md << " |\n|---";
+      for (std::size_t c = 0; c < list.headers.size() + md_columns; ++c)
+        md << "|---";
+      md << "|\n";
+      unsigned int n_failed = 0;
+      for (std::size_t i = 0; i < list.overrides.size(); ++i)
+        {
+          boost::property_tree::ptree tree;
+          try
+            {
+              boost::property_tree::read_json((numbered_dir(dir, "case", i) / "summary.json").string(), tree);
+            }
+          catch (const std::exception &)
+            {
+              tree.put("status", "missing");
+            }
+          if (tree.get<std::string>("status", "") != "complete")
+            ++n_failed;
+          csv << i;
+          md << "| " << i;
+          for (const std::string &value : list.columns[i])
+            {
+              csv << "," << csv_field(value);
+              md << " | " << value;
+            }
+          for (std::size_t k = 0; k < keys.size(); ++k)
+            {
+              const std::string v = value_of(tree, keys[k]);
+              csv << "," << csv_field(v);
+              if (is_stderr(keys[k]))
+                continue;
+              const std::string se = k + 1 < keys.size() && is_stderr(keys[k + 1]) ? value_of(tree, keys[k + 1]) : "";
+              md << " | " << (se.empty() || v.empty() ? v : significant(v, 5) + " +/- " + significant(se, 2));
+            }
+          csv << ","
+              << (shared.of_case[i] >= 0 ? numbered_dir(dir, "preparation", shared.of_case[i]).filename().string() : "")
+              << "," << numbered_dir(dir, "case", i).filename().string() << "\n";
+          md << " |\n";
+        }
+      atomic_write((dir / "study_summary.csv").string(), csv.str());
+      md << "\nCompaction: " << shared.note << ".\n";
+      atomic_write((dir / "study_summary.md").string(), md.str());
+      return n_failed;
+    }
+
+    /// The overlay plots of the profiles (a convenience: a failure is a warning) and, for
+    /// a tradeoff, tradeoff.csv, .md and .png (the table is what a tradeoff is for: a
+    /// failure is an error).
+    void make_study_plots(const fs::path &dir, bool tradeoff, bool quiet)
+    {
+      const std::string command = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR +
+                                  "/scripts/plot_study.py " + shell_quote(dir.string()) + " > " +
+                                  shell_quote((dir / "plots.log").string()) + " 2>&1";
+      if (std::system(command.c_str()) != 0 && !quiet)
+        std::cout << "warning: the study plots could not be made, see " << (dir / "plots.log").string() << std::endl;
+      if (!tradeoff)
+        return;
+      const std::string t = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR + "/scripts/tradeoff.py " +
+                            shell_quote(dir.string()) + " > " + shell_quote((dir / "tradeoff.log").string()) +
+                            " 2>&1";
+      if (std::system(t.c_str()) != 0)
+        throw RunError("the tradeoff table could not be made, see " + (dir / "tradeoff.log").string());
+      if (!quiet)
+        std::cout << "tradeoff: " << (dir / "tradeoff.md").string() << std::endl;
+    }
+  } // namespace
+
+  int run_study(const StudyOptions &o)
+  {
+    const StudyDefinition study = read_study(o);
+    CaseList              list  = study.tradeoff ? reference_and_ladders(study) : every_combination(study);
+    for (const auto &c : list.overrides)
+      check_case(study.base, c);
+    const SharedCompactions shared = shared_compactions(study, list);
+    for (const auto &prep : shared.preparations)
+      check_case(study.base, prep);
+
+    const fs::path dir = o.output_dir.empty() ? fs::path("output") / fs::path(o.study_file).stem()
+                                              : fs::path(o.output_dir);
+    const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
+    const unsigned int size = dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
+    if (rank == 0)
+      fs::create_directories(dir);
+    MPI_Barrier(MPI_COMM_WORLD);
+    // A case sharing a compaction starts from its state.
+    for (std::size_t i = 0; i < list.overrides.size(); ++i)
+      if (shared.of_case[i] >= 0)
+        list.overrides[i].push_back("Shear cell/Initial state=" +
+                                    fs::absolute(numbered_dir(dir, "preparation", shared.of_case[i])).string());
 
     if (rank == 0 && !o.quiet)
-      std::cout << "study: " << sharing_note << std::endl;
+      std::cout << "study: " << shared.note << std::endl;
     // The shared compactions first, one per rank at a time, then the cases: rank r takes
     // r, r + size, ...
-    for (std::size_t i = rank; i < preparations.size(); i += size)
-      if (!run_in(numbered_dir("preparation", i), preparations[i], "preparation " + std::to_string(i)))
+    for (std::size_t i = rank; i < shared.preparations.size(); i += size)
+      if (!run_into(numbered_dir(dir, "preparation", i), study.base, shared.preparations[i],
+                    "preparation " + std::to_string(i), o.quiet))
         return 128 + stop_requested();
     MPI_Barrier(MPI_COMM_WORLD);
-    for (std::size_t i = rank; i < cases.size(); i += size)
-      if (!run_in(case_dir(i), cases[i], "case " + std::to_string(i)))
+    for (std::size_t i = rank; i < list.overrides.size(); i += size)
+      if (!run_into(numbered_dir(dir, "case", i), study.base, list.overrides[i], "case " + std::to_string(i), o.quiet))
         return 128 + stop_requested();
     MPI_Barrier(MPI_COMM_WORLD);
     if (rank != 0)
       return exit_ok;
 
-    // The summary table, from every case's summary.json: a time-averaged figure with its
-    // batch-means standard error (the next key), written "mean +/- stderr" in the .md.
-    const std::vector<std::string> keys = {
-      "status", "mu_mean", "mu_stderr", "mu_std", "power_balance_ratio", "power_balance_ratio_stderr",
-      "power_lower_wall_mean", "power_dissipated_mean", "normal_force_mean", "normal_force_stderr",
-      "sigma_xx_mean", "sigma_xx_stderr", "sigma_yy_mean", "sigma_yy_stderr", "sigma_xy_mean",
-      "sigma_xy_stderr", "inertial_number", "cohesion_number", "steady_state_reached", "wall_time", "error"};
-    const auto is_stderr = [](const std::string &k) { return k.size() > 7 && k.substr(k.size() - 7) == "_stderr"; };
-    std::ostringstream csv, md;
-    csv << "case";
-    md << "| case";
-    for (const auto &h : headers)
-      {
-        csv << ",\"" << h << "\"";
-        md << " | " << h;
-      }
-    unsigned int md_columns = 0;
-    for (const auto &k : keys)
-      {
-        csv << "," << k;
-        if (!is_stderr(k))
-          {
-            md << " | " << k;
-            ++md_columns;
-          }
-      }
-    csv << ",preparation,directory\n";
-    md << " |\n|---";
-    for (std::size_t c = 0; c < headers.size() + md_columns; ++c)
-      md << "|---";
-    md << "|\n";
-    unsigned int n_failed = 0;
-    for (std::size_t i = 0; i < cases.size(); ++i)
-      {
-        boost::property_tree::ptree tree;
-        try
-          {
-            boost::property_tree::read_json((case_dir(i) / "summary.json").string(), tree);
-          }
-        catch (const std::exception &)
-          {
-            tree.put("status", "missing");
-          }
-        if (tree.get<std::string>("status", "") != "complete")
-          ++n_failed;
-        csv << i;
-        md << "| " << i;
-        for (const std::string &value : columns[i])
-          {
-            csv << "," << csv_field(value);
-            md << " | " << value;
-          }
-        for (std::size_t k = 0; k < keys.size(); ++k)
-          {
-            const std::string v = value_of(tree, keys[k]);
-            csv << "," << csv_field(v);
-            if (is_stderr(keys[k]))
-              continue;
-            const std::string se = k + 1 < keys.size() && is_stderr(keys[k + 1]) ? value_of(tree, keys[k + 1]) : "";
-            md << " | " << (se.empty() || v.empty() ? v : significant(v, 5) + " +/- " + significant(se, 2));
-          }
-        csv << ","
-            << (preparation_of_case[i] >= 0 ? numbered_dir("preparation", preparation_of_case[i]).filename().string()
-                                            : "")
-            << "," << case_dir(i).filename().string() << "\n";
-        md << " |\n";
-      }
-    atomic_write((dir / "study_summary.csv").string(), csv.str());
-    md << "\nCompaction: " << sharing_note << ".\n";
-    atomic_write((dir / "study_summary.md").string(), md.str());
-
-    // Overlay plots of the profiles (a convenience: a failure is a warning).
-    const std::string command = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR +
-                                "/scripts/plot_study.py " + shell_quote(dir.string()) + " > " +
-                                shell_quote((dir / "plots.log").string()) + " 2>&1";
-    if (std::system(command.c_str()) != 0 && !o.quiet)
-      std::cout << "warning: the study plots could not be made, see " << (dir / "plots.log").string() << std::endl;
-    if (tradeoff)
-      {
-        // Cost and error against the reference: tradeoff.csv, .md and .png. A failure here
-        // is an error: the table is what a tradeoff is for.
-        const std::string t = std::string(TRIBO_PYTHON) + " " + TRIBO_SOURCE_DIR + "/scripts/tradeoff.py " +
-                              shell_quote(dir.string()) + " > " + shell_quote((dir / "tradeoff.log").string()) +
-                              " 2>&1";
-        if (std::system(t.c_str()) != 0)
-          throw RunError("the tradeoff table could not be made, see " + (dir / "tradeoff.log").string());
-        if (!o.quiet)
-          std::cout << "tradeoff: " << (dir / "tradeoff.md").string() << std::endl;
-      }
+    const unsigned int n_failed = write_study_table(dir, list, shared);
+    make_study_plots(dir, study.tradeoff, o.quiet);
     if (!o.quiet)
-      std::cout << "study: " << cases.size() << " cases, " << n_failed << " not complete; table "
+      std::cout << "study: " << list.overrides.size() << " cases, " << n_failed << " not complete; table "
                 << (dir / "study_summary.csv").string() << std::endl;
     return exit_ok;
   }
