@@ -11,39 +11,108 @@
 
 namespace tribo::dem
 {
-  SolveReport ApgsSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state,
-                                        const ContactLaw &law)
+  namespace
   {
-    SolveReport                        report;
-    const SweepProblem                 problem(contacts, state, law);
-    const FrictionlessProblem::Scaled &scaled   = problem.scaled;
-    const Eigen::Index                 n        = problem.n_contacts();
-    const Eigen::Index                 w        = problem.width; // rows w j, ..., w j + w - 1: contact j
-    const Eigen::Index                 rows     = w * n;
-    const Eigen::VectorXd             &inv_root = scaled.inv_root;
-    const Eigen::VectorXd             &b        = scaled.b;
-    ScaledOperator                     op(scaled);
-
-    // Contact j's natural map in N s/m, y's rows set in op: without friction
-    // |min(y_j, g_j)| / sqrt(D_j); with friction the norm of (phi_n, phi_t) of
-    // dem/law_residual.h in the scaled variables (unit normal diagonal, tangent diagonal
-    // A'_tt), times the contact's scale.
-    auto contact_map = [&](const Eigen::VectorXd &y, Eigen::Index j) {
-      if (w == 1)
-        return std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * inv_root[j];
-      const Eigen::Index k      = 2 * j;
-      const double       g_n    = op.row_times(y, k) + b[k], g_t = op.row_times(y, k + 1) + b[k + 1];
-      const double       r_law  = std::max(0.0, y[k] - g_n);
-      const double       bound  = problem.friction * r_law;
-      const double       phi_n  = y[k] - r_law;
-      const double       phi_t  = y[k + 1] - std::clamp(y[k + 1] - g_t / problem.own_block[j](1, 1), -bound, bound);
-      return std::sqrt(phi_n * phi_n + phi_t * phi_t) * inv_root[k];
+    /// The per-chunk sums of a check: the worst contact's map, and the loaded impulses'
+    /// sum and count. Merged in chunk order: the same bits on any number of threads.
+    struct MapSums
+    {
+      double worst = 0, loaded_sum = 0, loaded = 0;
+      void   merge(const MapSums &p)
+      {
+        worst = std::max(worst, p.worst);
+        loaded_sum += p.loaded_sum;
+        loaded += p.loaded;
+      }
     };
-    // Contact j's local solve in v (rows set in op), the low-rank product kept current and,
-    // with @p also, the same changes added to it: without friction v_j = max(0, v_j - g_j)
-    // (unit diagonal); with friction the exact 2x2 Coulomb solve against the contact's own
-    // block B, u = B v_j + q (ContactLaw::solve_coulomb; v_j = 0 if q_n >= 0).
-    auto relax = [&](Eigen::VectorXd &v, Eigen::Index j, Eigen::VectorXd *also) {
+
+    /// One APGS solve (the method is in dem/solvers/apgs.h): its vectors and its steps, the
+    /// contact's map and local solve, the sweep in slabs, the check, the local polish and
+    /// its check, and the blocks of sweeps with momentum.
+    class ApgsRun
+    {
+    public:
+      ApgsRun(const SweepProblem &problem, const ContactLaw &law, const SolverParameters &prm, SolveReport &report);
+      /// The solve's final iterate, in the scaled variables of @p problem.
+      Eigen::VectorXd solve();
+
+    private:
+      const SweepProblem                 &problem;
+      const FrictionlessProblem::Scaled  &scaled;
+      const ContactLaw                   &law;
+      const SolverParameters             &prm;
+      SolveReport                        &report;
+      const Eigen::Index                  n, w, rows; ///< contacts; rows per contact (w j, ..., w j + w - 1: contact j)
+      ScaledOperator                      op;
+      Eigen::VectorXd                     error;         ///< each contact's map at the last check, N s/m
+      double                              mean_loaded;   ///< the mean loaded impulse at the last check, N s/m
+      std::vector<MapSums>                chunk_sums;    ///< the last check's sums per chunk
+      std::vector<Eigen::Index>           slab_start;    ///< the sweep's slabs, in contacts
+      std::vector<char>                   marked, affected, dirty;
+      std::vector<Eigen::Index>           local, affected_rows, chunks;
+
+      double contact_map(const Eigen::VectorXd &y, Eigen::Index j) const;
+      void   relax(Eigen::VectorXd &v, Eigen::Index j, Eigen::VectorXd *also);
+      bool   on_low_rank(Eigen::Index j) const;
+      MapSums map_of_rows(const Eigen::VectorXd &y, Eigen::Index first, Eigen::Index last,
+                          const std::vector<char> *only);
+      double merged_map();
+      double relative_map(const Eigen::VectorXd &y);
+      void   choose_slabs();
+      void   sweep(Eigen::VectorXd &v);
+      void   affect(Eigen::Index j);
+      bool   polish(Eigen::VectorXd &y, Eigen::VectorXd &z);
+      double recheck(const Eigen::VectorXd &y);
+      void   sweeps_with_momentum(Eigen::VectorXd &y, Eigen::VectorXd &y_last, Eigen::VectorXd &z,
+                                  Eigen::VectorXd &next, double &t);
+    };
+
+    ApgsRun::ApgsRun(const SweepProblem &problem, const ContactLaw &law, const SolverParameters &prm,
+                     SolveReport &report)
+      : problem(problem)
+      , scaled(problem.scaled)
+      , law(law)
+      , prm(prm)
+      , report(report)
+      , n(problem.n_contacts())
+      , w(problem.width)
+      , rows(w * n)
+      , op(scaled)
+      , error(n)
+      , mean_loaded(problem.scale)
+      , slab_start{0, n}
+      , marked(n, 0)
+      , affected(n, 0)
+      , dirty(chunk_count(n), 0)
+    {
+      choose_slabs();
+    }
+
+    /// Contact j's natural map in N s/m, y's rows set in op: without friction
+    /// |min(y_j, g_j)| / sqrt(D_j); with friction the norm of (phi_n, phi_t) of
+    /// dem/law_residual.h in the scaled variables (unit normal diagonal, tangent diagonal
+    /// A'_tt), times the contact's scale.
+    double ApgsRun::contact_map(const Eigen::VectorXd &y, Eigen::Index j) const
+    {
+      const Eigen::VectorXd &b = scaled.b;
+      if (w == 1)
+        return std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * scaled.inv_root[j];
+      const Eigen::Index k     = 2 * j;
+      const double       g_n   = op.row_times(y, k) + b[k], g_t = op.row_times(y, k + 1) + b[k + 1];
+      const double       r_law = std::max(0.0, y[k] - g_n);
+      const double       bound = problem.friction * r_law;
+      const double       phi_n = y[k] - r_law;
+      const double       phi_t = y[k + 1] - std::clamp(y[k + 1] - g_t / problem.own_block[j](1, 1), -bound, bound);
+      return std::sqrt(phi_n * phi_n + phi_t * phi_t) * scaled.inv_root[k];
+    }
+
+    /// Contact j's local solve in v (rows set in op), the low-rank product kept current and,
+    /// with @p also, the same changes added to it: without friction v_j = max(0, v_j - g_j)
+    /// (unit diagonal); with friction the exact 2x2 Coulomb solve against the contact's own
+    /// block B, u = B v_j + q (ContactLaw::solve_coulomb; v_j = 0 if q_n >= 0).
+    void ApgsRun::relax(Eigen::VectorXd &v, Eigen::Index j, Eigen::VectorXd *also)
+    {
+      const Eigen::VectorXd &b = scaled.b;
       if (w == 1)
         {
           const double next = std::max(0.0, v[j] - (op.row_times(v, j) + b[j]));
@@ -56,12 +125,12 @@ namespace tribo::dem
             }
           return;
         }
-      const Eigen::Index     k = 2 * j;
-      const Eigen::Matrix2d &B = problem.own_block[j];
-      const double q_n = op.row_times(v, k) + b[k] - B(0, 0) * v[k] - B(0, 1) * v[k + 1];
-      const double q_t = op.row_times(v, k + 1) + b[k + 1] - B(1, 0) * v[k] - B(1, 1) * v[k + 1];
-      const Eigen::Vector2d next = q_n < 0 ? law.solve_coulomb(B(0, 0), B(0, 1), B(1, 0), B(1, 1), q_n, q_t)
-                                           : Eigen::Vector2d::Zero();
+      const Eigen::Index     k   = 2 * j;
+      const Eigen::Matrix2d &B   = problem.own_block[j];
+      const double           q_n = op.row_times(v, k) + b[k] - B(0, 0) * v[k] - B(0, 1) * v[k + 1];
+      const double           q_t = op.row_times(v, k + 1) + b[k + 1] - B(1, 0) * v[k] - B(1, 1) * v[k + 1];
+      const Eigen::Vector2d  next = q_n < 0 ? law.solve_coulomb(B(0, 0), B(0, 1), B(1, 0), B(1, 1), q_n, q_t)
+                                            : Eigen::Vector2d::Zero();
       for (int p = 0; p < 2; ++p)
         if (next[p] != v[k + p])
           {
@@ -70,80 +139,73 @@ namespace tribo::dem
               (*also)[k + p] += next[p] - v[k + p];
             v[k + p] = next[p];
           }
-    };
-    // Whether a row of contact j has low-rank entries (a wall's contact).
-    auto on_low_rank = [&](Eigen::Index j) {
+    }
+
+    /// Whether a row of contact j has low-rank entries (a wall's contact).
+    bool ApgsRun::on_low_rank(Eigen::Index j) const
+    {
       for (Eigen::Index k = w * j; k < w * j + w; ++k)
         if (op.has_low_rank(k))
           return true;
       return false;
-    };
+    }
 
-    // The natural map at y over its mean loaded impulse (one product); each contact's
-    // map is kept in `error` and the mean in `mean_loaded` (N s/m).
-    Eigen::VectorXd error(n);
-    double          mean_loaded = problem.scale;
-    // Over fixed chunks (dem/solvers/scaled_operator.h), concurrently with Threads > 1, merged in
-    // chunk order: the same bits on any number of threads. The chunks' sums are kept, so
-    // that the check after a polish recomputes only the chunks that hold a changed row.
-    struct MapSums
+    /// The map of the contacts [first, last), op set to y; with @p only, just the marked
+    /// contacts' entries of `error` are recomputed (the others are still those of y).
+    MapSums ApgsRun::map_of_rows(const Eigen::VectorXd &y, Eigen::Index first, Eigen::Index last,
+                                 const std::vector<char> *only)
     {
-      double worst = 0, loaded_sum = 0, loaded = 0;
-      void   merge(const MapSums &p)
-      {
-        worst = std::max(worst, p.worst);
-        loaded_sum += p.loaded_sum;
-        loaded += p.loaded;
-      }
-    };
-    std::vector<MapSums> chunk_sums;
-    // The map of the rows [first, last) (with @p affected, only the marked rows' entries of
-    // `error` are recomputed; the others are still those of y), op set to y.
-    auto map_of_rows = [&](const Eigen::VectorXd &y, Eigen::Index first, Eigen::Index last,
-                           const std::vector<char> *affected) {
       MapSums part;
       for (Eigen::Index j = first; j < last; ++j)
         {
-          if (!affected || (*affected)[j])
+          if (!only || (*only)[j])
             error[j] = contact_map(y, j);
           part.worst = std::max(part.worst, error[j]);
           if (y[w * j] > 0)
             {
-              part.loaded_sum += y[w * j] * inv_root[w * j];
+              part.loaded_sum += y[w * j] * scaled.inv_root[w * j];
               ++part.loaded;
             }
         }
       return part;
-    };
-    auto merged_map = [&]() {
+    }
+
+    /// The worst map over the mean loaded impulse from the chunks' sums.
+    double ApgsRun::merged_map()
+    {
       const MapSums sums = merged_in_order(chunk_sums);
       mean_loaded        = sums.loaded > 0 ? sums.loaded_sum / sums.loaded : problem.scale;
       return sums.worst / mean_loaded;
-    };
-    // A whole check: one pass.
-    auto relative_map = [&](const Eigen::VectorXd &y) {
+    }
+
+    /// A whole check at y: one pass over fixed chunks (dem/solvers/scaled_operator.h),
+    /// concurrently with Threads > 1; the chunks' sums are kept for the check after a polish.
+    double ApgsRun::relative_map(const Eigen::VectorXd &y)
+    {
       ++report.iterations;
       op.set_vector(y);
-      chunk_partials(n, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
-        return map_of_rows(y, first, last, nullptr);
-      }, chunk_sums);
+      chunk_partials(
+        n, prm.threads, [&](Eigen::Index first, Eigen::Index last) { return map_of_rows(y, first, last, nullptr); },
+        chunk_sums);
       return merged_map();
-    };
-    // The sweep's order: the contacts (in detection order, rows of cells upwards) cut into
-    // slab_count slabs of consecutive contacts, the even slabs first, then the odd ones.
-    // When no contact couples two slabs that are not neighbours and the walls' low-rank rows
-    // lie in one slab, the slabs of one colour share nothing and run concurrently, with the
-    // same bits on any number of threads; otherwise one slab holds every contact.
-    std::vector<Eigen::Index> slab_start{0, n}; // in contacts
+    }
+
+    /// The sweep's order: the contacts (in detection order, rows of cells upwards) cut into
+    /// slab_count slabs of consecutive contacts, the even slabs first, then the odd ones.
+    /// When no contact couples two slabs that are not neighbours and the walls' low-rank rows
+    /// lie in one slab, the slabs of one colour share nothing and run concurrently, with the
+    /// same bits on any number of threads; otherwise one slab holds every contact.
+    void ApgsRun::choose_slabs()
     {
-      const Eigen::Index count = std::max<Eigen::Index>(1, std::min<Eigen::Index>(slab_count, n / 64) / 2 * 2);
+      const Eigen::Index count =
+        std::max<Eigen::Index>(1, std::min<Eigen::Index>(ApgsSolver::slab_count, n / 64) / 2 * 2);
       std::vector<Eigen::Index> start(count + 1);
       for (Eigen::Index q = 0; q <= count; ++q)
         start[q] = q * n / count;
       auto slab_of = [&](Eigen::Index j) {
         return Eigen::Index(std::upper_bound(start.begin(), start.end(), j) - start.begin()) - 1;
       };
-      bool         separate = count >= 2;
+      bool         separate      = count >= 2;
       Eigen::Index low_rank_slab = -1;
       for (Eigen::Index k = 0; k < rows && separate; ++k)
         {
@@ -152,54 +214,55 @@ namespace tribo::dem
             separate = std::abs(slab_of(a.row() / w) - s) <= 1;
           if (op.has_low_rank(k))
             {
-              separate = separate && (low_rank_slab < 0 || low_rank_slab == s);
+              separate      = separate && (low_rank_slab < 0 || low_rank_slab == s);
               low_rank_slab = s;
             }
         }
       if (separate)
         slab_start = start;
+      report.concurrent = slab_start.size() > 2 && prm.threads > 1;
     }
-    const Eigen::Index slabs = Eigen::Index(slab_start.size()) - 1;
-    report.concurrent        = slabs > 1 && prm.threads > 1;
-    // One projected Gauss-Seidel sweep of v in place.
-    auto sweep_slab = [&](Eigen::VectorXd &v, Eigen::Index q) {
-      for (Eigen::Index j = slab_start[q]; j < slab_start[q + 1]; ++j)
-        relax(v, j, nullptr);
-    };
-    auto sweep = [&](Eigen::VectorXd &v) {
+
+    /// One projected Gauss-Seidel sweep of v in place, colour by colour.
+    void ApgsRun::sweep(Eigen::VectorXd &v)
+    {
       ++report.iterations;
       op.set_vector(v);
+      const Eigen::Index slabs = Eigen::Index(slab_start.size()) - 1;
       for (const Eigen::Index colour : {0, 1})
         {
           const Eigen::Index count = (slabs - colour + 1) / 2; // slabs colour, colour + 2, ...
           auto work = [&](Eigen::Index first, Eigen::Index last) {
             for (Eigen::Index k = first; k < last; ++k)
-              sweep_slab(v, colour + 2 * k);
+              for (Eigen::Index j = slab_start[colour + 2 * k]; j < slab_start[colour + 2 * k + 1]; ++j)
+                relax(v, j, nullptr);
           };
           if (prm.threads > 1 && count > 1)
             dealii::parallel::apply_to_subranges(Eigen::Index(0), count, work, 1);
           else
             work(0, count);
         }
-    };
+    }
 
-    // The local polish: projected Gauss-Seidel passes over the contacts above the target and
-    // their neighbours up to polish_rings rings away in A' (ring 1: the rows of their
-    // columns), y changed in place and z by the same amount (the momentum y - y_last kept).
-    // False when nothing is above the target or the neighbourhood is too large to be local.
-    // It marks in `affected` (listed in `affected_rows`) the rows whose map it changed: the
-    // rows of the polished columns of A', and the walls' low-rank rows when a polished
-    // contact is one of them. All of it costs O(the polished contacts + the chunks).
-    std::vector<char>         marked(n, 0), affected(n, 0);
-    std::vector<Eigen::Index> local, affected_rows;
-    auto affect = [&](Eigen::Index j) {
+    /// Mark contact j's map as changed by the polish.
+    void ApgsRun::affect(Eigen::Index j)
+    {
       if (!affected[j])
         {
           affected[j] = 1;
           affected_rows.push_back(j);
         }
-    };
-    auto polish = [&](Eigen::VectorXd &y, Eigen::VectorXd &z) {
+    }
+
+    /// The local polish: projected Gauss-Seidel passes over the contacts above the target and
+    /// their neighbours up to polish_rings rings away in A' (ring 1: the rows of their
+    /// columns), y changed in place and z by the same amount (the momentum y - y_last kept).
+    /// False when nothing is above the target or the neighbourhood is too large to be local.
+    /// It marks (affect) the contacts whose map it changed: the rows of the polished columns
+    /// of A', and the walls' low-rank rows when a polished contact is one of them. All of it
+    /// costs O(the polished contacts + the chunks).
+    bool ApgsRun::polish(Eigen::VectorXd &y, Eigen::VectorXd &z)
+    {
       const double threshold = prm.residual_target * mean_loaded;
       local.clear();
       for (Eigen::Index c = 0; c < Eigen::Index(chunk_sums.size()); ++c)
@@ -211,7 +274,8 @@ namespace tribo::dem
                 local.push_back(j);
               }
       std::size_t last_ring = 0; // local[last_ring, ...) is the outermost ring so far
-      for (unsigned int ring = 0; ring < polish_rings && double(local.size()) <= polish_fraction * double(n); ++ring)
+      for (unsigned int ring = 0;
+           ring < ApgsSolver::polish_rings && double(local.size()) <= ApgsSolver::polish_fraction * double(n); ++ring)
         {
           const std::size_t inner = local.size();
           for (std::size_t q = std::exchange(last_ring, inner); q < inner; ++q)
@@ -226,10 +290,10 @@ namespace tribo::dem
       for (const Eigen::Index j : local)
         marked[j] = 0;
       std::sort(local.begin(), local.end()); // the sweep's order
-      if (local.empty() || double(local.size()) > polish_fraction * double(n))
+      if (local.empty() || double(local.size()) > ApgsSolver::polish_fraction * double(n))
         return false;
       op.set_vector(y);
-      for (unsigned int pass = 0; pass < polish_passes; ++pass)
+      for (unsigned int pass = 0; pass < ApgsSolver::polish_passes; ++pass)
         for (const Eigen::Index j : local)
           relax(y, j, &z);
       bool wall = false;
@@ -245,13 +309,13 @@ namespace tribo::dem
         for (const Eigen::Index k : op.low_rank_row_list())
           affect(k / w);
       return true;
-    };
-    // The check after a polish: the chunks that hold an affected row are recomputed, the
-    // others keep their sums (y did not change there): the bits of a whole check, at the
-    // polish's cost. Not counted as a pass.
-    std::vector<char>         dirty(chunk_count(n), 0);
-    std::vector<Eigen::Index> chunks; // the dirty chunks, in the order found
-    auto recheck = [&](const Eigen::VectorXd &y) {
+    }
+
+    /// The check after a polish: the chunks that hold an affected contact are recomputed,
+    /// the others keep their sums (y did not change there): the bits of a whole check, at
+    /// the polish's cost. Not counted as a pass.
+    double ApgsRun::recheck(const Eigen::VectorXd &y)
+    {
       op.set_vector(y);
       chunks.clear();
       for (const Eigen::Index j : affected_rows)
@@ -269,85 +333,105 @@ namespace tribo::dem
         affected[j] = 0;
       affected_rows.clear();
       return merged_map();
-    };
+    }
 
-    Eigen::VectorXd y = w == 1 ? Eigen::VectorXd(scaled.y.cwiseMax(0.0)) : scaled.y, y_last(rows), z = y, next(rows);
-    double          t        = 1;
-    // Polishes since the last block of sweeps, and since the lowest map among them.
-    unsigned int polished = 0, since_lowest = 0;
-    double       lowest   = INFINITY;
-    double       map      = relative_map(y);
-    // With friction (width 2) the sweep is no gradient step of a potential (the law is not
-    // associated) and the momentum has no guarantee: the safeguard keeps the best iterate
-    // of the whole checks, drops the momentum when a block raises the map, and returns the
-    // best iterate if the solve ends above it.
-    Eigen::VectorXd best       = w == 2 ? y : Eigen::VectorXd();
-    double          best_map   = map, block_map = map;
-    while (map > prm.residual_target)
+    /// check_interval sweeps with Nesterov's momentum and the gradient restart (the header's
+    /// recursion): y_{k+1} = S(z_k), z_{k+1} = y_{k+1} + (t_k - 1) / t_{k+1} (y_{k+1} - y_k).
+    /// The vector passes run over fixed chunks, as the check (the same bits on any number of
+    /// threads); the next sweep's start (next = z) is written with z.
+    void ApgsRun::sweeps_with_momentum(Eigen::VectorXd &y, Eigen::VectorXd &y_last, Eigen::VectorXd &z,
+                                       Eigen::VectorXd &next, double &t)
+    {
+      struct Sum
       {
-        if (report.iterations >= prm.max_iterations)
-          {
-            report.converged = false;
-            break;
-          }
-        if (polished < max_polishes && since_lowest < polish_patience && polish(y, z))
-          {
-            ++polished;
-            map = recheck(y);
-            since_lowest = map < lowest ? 0 : since_lowest + 1;
-            lowest       = std::min(lowest, map);
-            continue;
-          }
-        polished = since_lowest = 0;
-        lowest                  = INFINITY;
-        // The vector passes over fixed chunks, as the check (the same bits on any number of
-        // threads); the next sweep's start (next = z) written with z.
-        struct Sum
+        double value = 0;
+        void   merge(const Sum &p) { value += p.value; }
+      };
+      next = z;
+      for (unsigned int k = 0; k < ApgsSolver::check_interval; ++k)
         {
-          double value = 0;
-          void   merge(const Sum &p) { value += p.value; }
-        };
-        next = z;
-        for (unsigned int k = 0; k < check_interval; ++k)
-          {
-            sweep(next);
-            const double opposed = over_chunks<Sum>(rows, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
-              Sum part;
-              for (Eigen::Index j = first; j < last; ++j)
-                part.value += (z[j] - next[j]) * (next[j] - y[j]);
-              return part;
-            }).value;
-            if (opposed > 0)
-              t = 1;
-            const double t_next = 0.5 * (1 + std::sqrt(1 + 4 * t * t));
-            const double beta   = (t - 1) / t_next;
-            y_last.swap(y);
-            y.swap(next);
-            over_chunks<NoSums>(rows, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
-              for (Eigen::Index j = first; j < last; ++j)
-                next[j] = z[j] = y[j] + beta * (y[j] - y_last[j]);
-              return NoSums{};
-            });
-            t = t_next;
-          }
-        map = relative_map(y);
-        if (w == 2)
-          {
-            if (map < best_map)
-              {
-                best     = y;
-                best_map = map;
-              }
-            else if (map > block_map)
-              {
-                t = 1;
-                z = y;
-              }
-            block_map = map;
-          }
-      }
-    if (w == 2 && best_map < map)
-      y = best; // the safeguard's best iterate (its map is best_map)
+          sweep(next);
+          const double opposed = over_chunks<Sum>(rows, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+                                   Sum part;
+                                   for (Eigen::Index j = first; j < last; ++j)
+                                     part.value += (z[j] - next[j]) * (next[j] - y[j]);
+                                   return part;
+                                 }).value;
+          if (opposed > 0)
+            t = 1;
+          const double t_next = 0.5 * (1 + std::sqrt(1 + 4 * t * t));
+          const double beta   = (t - 1) / t_next;
+          y_last.swap(y);
+          y.swap(next);
+          over_chunks<NoSums>(rows, prm.threads, [&](Eigen::Index first, Eigen::Index last) {
+            for (Eigen::Index j = first; j < last; ++j)
+              next[j] = z[j] = y[j] + beta * (y[j] - y_last[j]);
+            return NoSums{};
+          });
+          t = t_next;
+        }
+    }
+
+    Eigen::VectorXd ApgsRun::solve()
+    {
+      Eigen::VectorXd y = w == 1 ? Eigen::VectorXd(scaled.y.cwiseMax(0.0)) : scaled.y, y_last(rows), z = y,
+                      next(rows);
+      double t = 1;
+      // Polishes since the last block of sweeps, and since the lowest map among them.
+      unsigned int polished = 0, since_lowest = 0;
+      double       lowest   = INFINITY;
+      double       map      = relative_map(y);
+      // With friction (width 2) the sweep is no gradient step of a potential (the law is not
+      // associated) and the momentum has no guarantee: the safeguard keeps the best iterate
+      // of the whole checks, drops the momentum when a block raises the map, and returns the
+      // best iterate if the solve ends above it.
+      Eigen::VectorXd best     = w == 2 ? y : Eigen::VectorXd();
+      double          best_map = map, block_map = map;
+      while (map > prm.residual_target)
+        {
+          if (report.iterations >= prm.max_iterations)
+            {
+              report.converged = false;
+              break;
+            }
+          if (polished < ApgsSolver::max_polishes && since_lowest < ApgsSolver::polish_patience && polish(y, z))
+            {
+              ++polished;
+              map          = recheck(y);
+              since_lowest = map < lowest ? 0 : since_lowest + 1;
+              lowest       = std::min(lowest, map);
+              continue;
+            }
+          polished = since_lowest = 0;
+          lowest                  = INFINITY;
+          sweeps_with_momentum(y, y_last, z, next, t);
+          map = relative_map(y);
+          if (w == 2)
+            {
+              if (map < best_map)
+                {
+                  best     = y;
+                  best_map = map;
+                }
+              else if (map > block_map)
+                {
+                  t = 1;
+                  z = y;
+                }
+              block_map = map;
+            }
+        }
+      if (w == 2 && best_map < map)
+        y = best; // the safeguard's best iterate (its map is best_map)
+      return y;
+    }
+  } // namespace
+
+  SolveReport ApgsSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law)
+  {
+    SolveReport        report;
+    const SweepProblem problem(contacts, state, law);
+    const Eigen::VectorXd y = ApgsRun(problem, law, prm, report).solve();
     problem.apply(y, contacts, state);
     return report;
   }

@@ -25,17 +25,16 @@
 /// concurrently with SolverParameters::threads > 1, with the same bits on any number of
 /// threads (SolveReport::concurrent says so); otherwise one slab holds every contact.
 ///
-/// Local polish (since 2026-11-26, sixth session): after a check that fails, the contacts
+/// Local polish: after a check that fails, the contacts
 /// above the target and their neighbours up to polish_rings rings away in A' (while they are
 /// at most polish_fraction of all) get polish_passes projected Gauss-Seidel passes, in the
 /// sweep's order, over them alone (y changed in place, z by the same amount, so the momentum
 /// y - y_last is kept), then a new check of the rows the polish changed (the polished
 /// contacts' rows of A', and the walls' low-rank rows when a polished contact is one of
 /// them; the other contacts' map is still the last check's: the same bits as a whole check
-/// at the polish's cost, not counted as a pass since 2026-11-27, eighth session). Polishes
+/// at the polish's cost, not counted as a pass). Polishes
 /// go on until polish_patience of them in a row have not lowered the map (at most
-/// max_polishes); then a block of check_interval sweeps. Until the checks after a polish
-/// were local, each cost a whole pass and at most four polishes paid. The warm start's
+/// max_polishes); then a block of check_interval sweeps. The warm start's
 /// worst contacts are a tail whose error grows with the sample (its largest |min(y_j, g_j)| over the mean impulse 6e-3, 1.2e-2, 2.1e-2 and 4.8e-2
 /// at 1000, 4000, 16 000 and 64 000 grains, while its root mean square stays near 6e-4):
 /// whole sweeps spent on that tail are what made the sweeps grow with the width, and the
