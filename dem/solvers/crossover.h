@@ -98,7 +98,7 @@ namespace tribo::dem
                               std::vector<char> &closed, const CrossoverTarget &target,
                               Eigen::VectorXd &y, Eigen::VectorXd &g);
 
-  /// The crossover's constants (docs/performance.md, 2026-11-26, fifth session).
+  /// The crossover's constants (docs/performance.md, "Design choices and ideas not kept": 0ac2662).
   namespace crossover
   {
     /// The shift of the preconditioner's closed block.
