@@ -379,16 +379,27 @@ namespace tribo::app
       return shared;
     }
 
-    /// Check one case of @p base with @p overrides without running it (bad input fails
-    /// fast, exit 2).
-    void check_case(const fs::path &base, const std::vector<std::string> &overrides)
+    /// Check one case (@p label) of @p base with @p overrides without running it: bad input
+    /// fails fast (exit 2), the message naming the study file and the case.
+    void check_case(const std::string &study_file, const std::string &label, const fs::path &base,
+                    const std::vector<std::string> &overrides)
     {
       RunOptions check;
       check.case_file  = base.string();
       check.overrides  = overrides;
       check.check_only = true;
       check.quiet      = true;
-      run_case(check);
+      try
+        {
+          run_case(check);
+        }
+      catch (const InputError &e)
+        {
+          std::string entries;
+          for (const auto &a : overrides)
+            entries += (entries.empty() ? "" : "; ") + a;
+          throw InputError(study_file + ": " + label + " (" + entries + "): " + e.what());
+        }
     }
 
     /// OUTPUT/STEM_NNN.
@@ -552,11 +563,11 @@ namespace tribo::app
   {
     const StudyDefinition study = read_study(o);
     CaseList              list  = study.tradeoff ? reference_and_ladders(study) : every_combination(study);
-    for (const auto &c : list.overrides)
-      check_case(study.base, c);
+    for (std::size_t i = 0; i < list.overrides.size(); ++i)
+      check_case(o.study_file, "case " + std::to_string(i), study.base, list.overrides[i]);
     const SharedCompactions shared = shared_compactions(study, list);
-    for (const auto &prep : shared.preparations)
-      check_case(study.base, prep);
+    for (std::size_t i = 0; i < shared.preparations.size(); ++i)
+      check_case(o.study_file, "shared compaction " + std::to_string(i), study.base, shared.preparations[i]);
 
     const fs::path dir = o.output_dir.empty() ? fs::path("output") / fs::path(o.study_file).stem()
                                               : fs::path(o.output_dir);

@@ -7,6 +7,7 @@
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
 
+#include <algorithm>
 #include <cctype>
 
 #include <filesystem>
@@ -39,7 +40,45 @@ namespace tribo
       const auto e = s.find_last_not_of(" \t\r");
       return b == std::string::npos ? "" : s.substr(b, e - b + 1);
     }
+
+    /// Levenshtein distance of @p a and @p b, case ignored.
+    std::size_t edit_distance(const std::string &a, const std::string &b)
+    {
+      std::vector<std::size_t> row(b.size() + 1);
+      for (std::size_t j = 0; j <= b.size(); ++j)
+        row[j] = j;
+      for (std::size_t i = 1; i <= a.size(); ++i)
+        {
+          std::size_t diagonal = row[0];
+          row[0]               = i;
+          for (std::size_t j = 1; j <= b.size(); ++j)
+            {
+              const bool        same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                                std::tolower(static_cast<unsigned char>(b[j - 1]));
+              const std::size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+              diagonal               = row[j];
+              row[j]                 = next;
+            }
+        }
+      return row[b.size()];
+    }
   } // namespace
+
+  std::string ParameterFile::nearest_entry_hint(const std::string &path) const
+  {
+    std::string best;
+    std::size_t best_distance = std::string::npos;
+    for (const auto &[declared, value] : resolved())
+      {
+        const std::size_t d = edit_distance(path, declared);
+        if (d < best_distance)
+          {
+            best          = declared;
+            best_distance = d;
+          }
+      }
+    return best_distance <= std::max<std::size_t>(2, path.size() / 3) ? " (did you mean '" + best + "'?)" : "";
+  }
 
   ParameterFile::ParameterFile(dealii::ParameterHandler &prm)
     : prm(prm)
@@ -120,7 +159,20 @@ namespace tribo
       }
     catch (const dealii::ExceptionBase &e)
       {
-        throw InputError(filename + ": " + describe(e));
+        const std::string      info = describe(e);
+        static const std::regex undeclared("Line <(\\d+)> of file <[^>]*>: No entry with name <(.*)> was declared.*");
+        static const std::regex subsection(".*There is no such subsection to be entered: (.*)");
+        std::smatch             m;
+        std::string             hint;
+        if (std::regex_match(info, m, undeclared))
+          {
+            for (const auto &[p, l] : lines)
+              if (l == std::stoul(m[1]))
+                hint = nearest_entry_hint(p);
+          }
+        else if (std::regex_match(info, m, subsection) && trim(m[1]) == "Study")
+          hint = " (a study file: run it with `tribo study` or `tribo tradeoff`)";
+        throw InputError(filename + ": " + info + hint);
       }
   }
 
@@ -136,7 +188,8 @@ namespace tribo
       throw InputError("--set '" + assignment + "': expected \"Subsection/Entry=value\"");
     const std::string entry = parts.back();
     parts.pop_back();
-    unsigned int depth = 0;
+    unsigned int depth    = 0;
+    bool         declared = true;
     try
       {
         for (const auto &s : parts)
@@ -147,8 +200,14 @@ namespace tribo
             prm.enter_subsection(s);
             ++depth;
           }
-        prm.get(entry); // throws if the entry is not declared
-        prm.set(entry, value);
+        try
+          {
+            prm.set(entry, value);
+          }
+        catch (const dealii::ParameterHandler::ExcEntryUndeclared &)
+          {
+            declared = false;
+          }
       }
     catch (const dealii::ExceptionBase &e)
       {
@@ -164,6 +223,15 @@ namespace tribo
       }
     for (; depth > 0; --depth)
       prm.leave_subsection();
+    if (!declared)
+      {
+        std::string full;
+        for (const auto &s : parts)
+          full += s + "/";
+        full += entry;
+        throw InputError("--set '" + assignment + "': there is no entry '" + full + "'" + nearest_entry_hint(full) +
+                         " (see `tribo params`)");
+      }
     overridden[path] = true;
   }
 

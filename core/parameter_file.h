@@ -69,6 +69,9 @@ namespace tribo
 
   private:
     static std::vector<std::string> split_path(const std::string &path);
+    /// " (did you mean 'Subsection/Entry'?)" for the declared entry nearest to @p path in
+    /// edit distance (case ignored), when it is within a third of the name; else "".
+    std::string nearest_entry_hint(const std::string &path) const;
 
     dealii::ParameterHandler &prm;
     std::string file = "(no file)";

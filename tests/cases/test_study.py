@@ -163,6 +163,9 @@ class Study(WithBaseCase):
                            capture_output=True, text=True, timeout=60)
         self.assertEqual(p.returncode, 2)
         self.assertIn("entry 'Contact law/Cohesion' = '-5': expected a cohesion >= 0 in N/m", p.stderr)
+        # The message names the study file and the case the bad value makes.
+        self.assertIn("study.prm: case 1 (", p.stderr)
+        self.assertIn("Contact law/Cohesion=-5", p.stderr)
         self.assertFalse(os.path.exists(out))
 
 

@@ -77,7 +77,15 @@ class MisspeltNames(BadInputTestCase):
     def test_misspelt_entry(self):
         msg, where = self.run_bad_case(case({"Simulation/Time stepp": "1e-9"}))
         self.assert_at_line(msg, where["Simulation/Time stepp"])
-        self.assert_parts(msg, "case.prm", "<Time stepp>", "No entry", "declared")
+        self.assert_parts(msg, "case.prm", "<Time stepp>", "No entry", "declared",
+                          "(did you mean 'Simulation/Time step'?)")
+
+    def test_a_study_file_given_as_a_case_says_how_to_run_it(self):
+        with open(os.path.join(self.tmp, "study.prm"), "w") as f:
+            f.write("subsection Study\n  set Base case = case.prm\nend\n")
+        msg = self.run_bad(["check", "study.prm"])
+        self.assert_parts(msg, "study.prm", "no such subsection to be entered: Study",
+                          "(a study file: run it with `tribo study` or `tribo tradeoff`)")
 
     def test_misspelt_subsection(self):
         sections = {"Simulaton": {"Time step": "1e-9"}}
@@ -307,7 +315,13 @@ class CommandLine(BadInputTestCase):
 
     def test_set_unknown_entry(self):
         msg = self.run_set("Simulation/Foo=1")
-        self.assert_parts(msg, "--set 'Simulation/Foo=1'", "<Foo>", "not yet declared")
+        self.assertEqual(msg, "error: --set 'Simulation/Foo=1': there is no entry 'Simulation/Foo' "
+                         "(see `tribo params`)")
+
+    def test_set_misspelt_entry_names_the_nearest(self):
+        msg = self.run_set("Shear cell/Sliding speed=2")
+        self.assertEqual(msg, "error: --set 'Shear cell/Sliding speed=2': there is no entry 'Shear "
+                         "cell/Sliding speed' (did you mean 'Shear cell/Sliding velocity'?) (see `tribo params`)")
 
     def test_set_unknown_subsection(self):
         msg = self.run_set("Simulatio/Time step=1e-9")
