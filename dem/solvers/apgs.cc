@@ -17,10 +17,11 @@ namespace tribo::dem
     /// sum and count. Merged in chunk order: the same bits on any number of threads.
     struct MapSums
     {
-      double worst = 0, loaded_sum = 0, loaded = 0;
+      double worst = 0, loaded_sum = 0, loaded = 0, gap = 0;
       void   merge(const MapSums &p)
       {
         worst = std::max(worst, p.worst);
+        gap   = std::max(gap, p.gap);
         loaded_sum += p.loaded_sum;
         loaded += p.loaded;
       }
@@ -32,7 +33,8 @@ namespace tribo::dem
     class ApgsRun
     {
     public:
-      ApgsRun(const SweepProblem &problem, const ContactLaw &law, const SolverParameters &prm, SolveReport &report);
+      ApgsRun(const SweepProblem &problem, const ContactLaw &law, const SolverParameters &prm, double theta_h,
+              SolveReport &report);
       /// The solve's final iterate, in the scaled variables of @p problem.
       Eigen::VectorXd solve();
 
@@ -45,7 +47,11 @@ namespace tribo::dem
       const Eigen::Index                  n, w, rows; ///< contacts; rows per contact (w j, ..., w j + w - 1: contact j)
       ScaledOperator                      op;
       Eigen::VectorXd                     error;         ///< each contact's map at the last check, N s/m
+      /// SolverParameters::gap_tolerance with IQS (m; 0: no gap test) and theta h (s).
+      const double                        gap_tolerance, theta_h;
+      Eigen::VectorXd                     gap;           ///< each contact's gap violation at the last check, m
       double                              mean_loaded;   ///< the mean loaded impulse at the last check, N s/m
+      double                              worst_gap = 0; ///< the largest gap violation at the last check, m
       std::vector<MapSums>                chunk_sums;    ///< the last check's sums per chunk
       std::vector<Eigen::Index>           slab_start;    ///< the sweep's slabs, in contacts
       std::vector<char>                   marked, affected, dirty;
@@ -57,6 +63,8 @@ namespace tribo::dem
       MapSums map_of_rows(const Eigen::VectorXd &y, Eigen::Index first, Eigen::Index last,
                           const std::vector<char> *only);
       double merged_map();
+      /// Whether the last check's gap violation is above the gap tolerance.
+      bool   gaps_open() const { return gap_tolerance > 0 && worst_gap > gap_tolerance; }
       double relative_map(const Eigen::VectorXd &y);
       void   choose_slabs();
       void   sweep(Eigen::VectorXd &v);
@@ -68,7 +76,7 @@ namespace tribo::dem
     };
 
     ApgsRun::ApgsRun(const SweepProblem &problem, const ContactLaw &law, const SolverParameters &prm,
-                     SolveReport &report)
+                     double theta_h, SolveReport &report)
       : problem(problem)
       , scaled(problem.scaled)
       , law(law)
@@ -79,6 +87,9 @@ namespace tribo::dem
       , rows(w * n)
       , op(scaled)
       , error(n)
+      , gap_tolerance(law.type == ContactLaw::Type::iqs && theta_h > 0 ? prm.gap_tolerance : 0.0)
+      , theta_h(theta_h)
+      , gap(n)
       , mean_loaded(problem.scale)
       , slab_start{0, n}
       , marked(n, 0)
@@ -159,8 +170,18 @@ namespace tribo::dem
       for (Eigen::Index j = first; j < last; ++j)
         {
           if (!only || (*only)[j])
-            error[j] = contact_map(y, j);
+            {
+              error[j] = contact_map(y, j);
+              if (gap_tolerance > 0)
+                {
+                  // u~_n = g_n sqrt(D) (m/s): its closing part times theta h.
+                  const Eigen::Index k = w * j;
+                  gap[j] = theta_h * std::max(0.0, -(op.row_times(y, k) + scaled.b[k])) / scaled.inv_root[k];
+                }
+            }
           part.worst = std::max(part.worst, error[j]);
+          if (gap_tolerance > 0)
+            part.gap = std::max(part.gap, gap[j]);
           if (y[w * j] > 0)
             {
               part.loaded_sum += y[w * j] * scaled.inv_root[w * j];
@@ -175,6 +196,7 @@ namespace tribo::dem
     {
       const MapSums sums = merged_in_order(chunk_sums);
       mean_loaded        = sums.loaded > 0 ? sums.loaded_sum / sums.loaded : problem.scale;
+      worst_gap          = sums.gap;
       return sums.worst / mean_loaded;
     }
 
@@ -266,9 +288,9 @@ namespace tribo::dem
       const double threshold = prm.residual_target * mean_loaded;
       local.clear();
       for (Eigen::Index c = 0; c < Eigen::Index(chunk_sums.size()); ++c)
-        if (chunk_sums[c].worst > threshold)
+        if (chunk_sums[c].worst > threshold || (gap_tolerance > 0 && chunk_sums[c].gap > gap_tolerance))
           for (Eigen::Index j = c * chunk_size; j < std::min(n, (c + 1) * chunk_size); ++j)
-            if (error[j] > threshold)
+            if (error[j] > threshold || (gap_tolerance > 0 && gap[j] > gap_tolerance))
               {
                 marked[j] = 1;
                 local.push_back(j);
@@ -387,7 +409,7 @@ namespace tribo::dem
       // best iterate if the solve ends above it.
       Eigen::VectorXd best     = w == 2 ? y : Eigen::VectorXd();
       double          best_map = map, block_map = map;
-      while (map > prm.residual_target)
+      while (map > prm.residual_target || gaps_open())
         {
           if (report.iterations >= prm.max_iterations)
             {
@@ -431,7 +453,7 @@ namespace tribo::dem
   {
     SolveReport        report;
     const SweepProblem problem(contacts, state, law);
-    const Eigen::VectorXd y = ApgsRun(problem, law, prm, report).solve();
+    const Eigen::VectorXd y = ApgsRun(problem, law, prm, step_theta_h, report).solve();
     problem.apply(y, contacts, state);
     return report;
   }

@@ -33,6 +33,7 @@ namespace tribo::dem
     unsigned int sweeps = 0;
     if (prm.predictor_sweeps > 0)
       sweeps = predictor.solve(contacts, state, law, theta_h).iterations;
+    step_theta_h       = theta_h;
     SolveReport report = solve_problem(contacts, state, law);
     if (!report.converged && falls_back_to_nlgs())
       {

@@ -31,6 +31,8 @@ namespace tribo::dem
     /// each method says.
     virtual SolveReport solve_problem(std::vector<Contact> &contacts, BodyState &state,
                                       const ContactLaw &law) = 0;
+    /// theta h of the step being solved (s): a closing velocity times it is a gap violation (m).
+    double step_theta_h = 0;
 
   private:
     NlgsSolver nlgs;      ///< the frictional steps and the fallbacks

@@ -45,10 +45,10 @@ namespace tribo::dem
                       "updates per second for about 3 % more sweeps, and change the trajectory "
                       "(docs/performance.md).");
     prm.declare_entry("Gap tolerance", "0", Double(),
-                      "NLGS: extra IQS convergence criterion, as a fraction of the smallest radius (>= 0; "
-                      "0: off, the established code's norms only): every contact's gap violation "
-                      "theta h max(0, -(u_n + shift)) must be below it. Limits the overlaps that the "
-                      "norms let accumulate under high pressure, at the price of more sweeps.");
+                      "NLGS and APGS: extra IQS convergence criterion, as a fraction of the smallest radius "
+                      "(>= 0; 0: off, NLGS's norms or APGS's Residual target only): every contact's gap "
+                      "violation theta h max(0, -(u_n + shift)) must be below it. Limits the overlaps that "
+                      "a loose solve lets accumulate under high pressure, at the price of more sweeps.");
   }
 
   void NlgsSolver::parse(const ParameterFile &f, SolverParameters &p)
@@ -72,7 +72,8 @@ namespace tribo::dem
       f.get_checked(entry("Gap tolerance"), is_non_negative, "a fraction >= 0 of the smallest radius");
     if (p.method != SolverParameters::Method::nlgs)
       for (const char *name : {"Tolerance", "Norm", "Check interval", "Gap tolerance"})
-        if (!f.is_default(entry(name)))
+        if (!f.is_default(entry(name)) &&
+            !(p.method == SolverParameters::Method::apgs && std::string(name) == "Gap tolerance"))
           p.unused_nlgs_entries += std::string(p.unused_nlgs_entries.empty() ? "" : ", ") + entry(name) +
                                    " (" + f.where(entry(name)) + ")";
   }

@@ -809,3 +809,28 @@ TEST(ContactSolvers, AStepAboveTheGapTargetIsNotConverged)
       EXPECT_LT(r.gap_violation, 1e-3 * radius);
     }
 }
+
+TEST(ContactSolvers, ApgsWithAGapToleranceKeepsEveryStepsGapBelowIt)
+{
+  // The landing of AStepAboveTheGapTargetIsNotConverged, where APGS at a law residual of 1e-3
+  // alone leaves steps above a gap violation of 1e-3 r: with Solver/Gap tolerance = 1e-3 r it
+  // sweeps on until every contact's gap violation theta h max(0, -(u_n + b)) is below that,
+  // so every step converges and the overlaps stop growing through the loose solve.
+  ParticleSystem s     = hexagonal_stack(0, 0);
+  RigidBody     &upper = s.bodies.back();
+  upper.mass *= 1e4;
+  upper.velocity = {0, -10};
+  SolverParameters apgs;
+  apgs.method          = SolverParameters::Method::apgs;
+  apgs.residual_target = 1e-3;
+  apgs.gap_target      = 1e-3 * radius;
+  apgs.gap_tolerance   = 1e-3 * radius;
+  MoreauJean mj(0.5, ContactLaw{}, apgs, 0.1 * radius);
+  for (int i = 0; i < 20; ++i)
+    {
+      const SolveReport r = mj.step(s, h).solver;
+      EXPECT_TRUE(r.converged) << "step " << i;
+      EXPECT_LE(r.gap_violation, 1e-3 * radius * (1 + 1e-6)) << "step " << i;
+      EXPECT_LE(r.law_residual, 1e-3) << "step " << i;
+    }
+}
