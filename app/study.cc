@@ -140,15 +140,17 @@ namespace tribo::app
       return preparation;
     }
 
-    /// Number @p v with @p digits significant digits (v itself if it is not a number).
+    /// Number @p v with @p digits significant digits (v itself if it is not wholly a number).
     std::string significant(const std::string &v, int digits)
     {
       try
         {
+          std::size_t        used = 0;
+          const double       x    = std::stod(v, &used);
           std::ostringstream os;
           os.precision(digits);
-          os << std::stod(v);
-          return os.str();
+          os << x;
+          return used == v.size() ? os.str() : v;
         }
       catch (const std::exception &)
         {
@@ -524,7 +526,7 @@ namespace tribo::app
               if (is_stderr(keys[k]))
                 continue;
               const std::string se = k + 1 < keys.size() && is_stderr(keys[k + 1]) ? value_of(tree, keys[k + 1]) : "";
-              md << " | " << (se.empty() || v.empty() ? v : significant(v, 5) + " +/- " + significant(se, 2));
+              md << " | " << (v.empty() ? v : se.empty() ? significant(v, 5) : significant(v, 5) + " +/- " + significant(se, 2));
             }
           csv << ","
               << (shared.of_case[i] >= 0 ? numbered_dir(dir, "preparation", shared.of_case[i]).filename().string() : "")

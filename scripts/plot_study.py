@@ -63,10 +63,10 @@ def main(directory):
                 xs = list(range(len(group)))
             order = np.argsort(xs)
             ax.errorbar(np.array(xs)[order], np.array([float(r["mu_mean"]) for r in group])[order],
-                        yerr=np.array([float(r["mu_std"]) for r in group])[order], marker="o", capsize=3,
+                        yerr=np.array([float(r["mu_stderr"] or 0) for r in group])[order], marker="o", capsize=3,
                         label=", ".join(f"{k.split('/')[-1]}={v}" for k, v in zip(varied[1:], key)) or None)
         ax.set_xlabel(x_key)
-        ax.set_ylabel("mean friction coefficient (+/- std)")
+        ax.set_ylabel("mean friction coefficient (+/- standard error)")
         if len(groups) > 1:
             ax.legend(fontsize=8)
         save(fig, os.path.join(directory, "mu_by_case.png"))
