@@ -227,6 +227,16 @@ class Reproduction(TempDirTestCase):
         self.assertIn("walls of touching 0.96 um discs give 6.3 +/- 0.15 MPa, with the layer a plug that the lower "
                       "wall slides under", verdict)
 
+    def test_the_paper_size_reference_joins_the_friction_row(self):
+        write_reference(self.tmp, 100.0, 0.1)
+        os.makedirs(os.path.join(self.tmp, "tradeoff_paper_solver"))
+        with open(os.path.join(self.tmp, "tradeoff_paper_solver", "study_summary.csv"), "w") as f:
+            f.write("case,knob,value,status,mu_mean,mu_stderr,sigma_xy_mean,sigma_xy_stderr,directory\n"
+                    "0,reference,x,complete,0.1164,0.001,11.64e6,1e5,case_000\n")
+        ours = reproduction_rows(reproduction(self.tmp).stdout)["sigma_xy without cohesion (IQS, 100 MPa, 5 m/s)"][0]
+        self.assertTrue(ours.endswith("at the paper's size (3820 grains), interior point 1e-8: 11.64 +/- 0.1 MPa "
+                                      "(mu 0.1164 +/- 0.001)"), ours)
+
     def test_a_load_two_errors_off_is_not_reproduced(self):
         write_reference(self.tmp, 100.3, 0.1)
         rows = reproduction_rows(reproduction(self.tmp).stdout)
