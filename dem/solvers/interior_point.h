@@ -22,7 +22,7 @@
 ///   a longer trial step a~ = min(1, 1.5 alpha + 0.1) back into [0.1, 10] sigma mu; dy + dc
 ///   is kept while it lengthens the step (15 % fewer factorisations, docs/performance.md);
 /// - step: 0.995 of the largest step that keeps y, s > 0, the same for both;
-/// - crossover (since 2026-11-26, fifth session): once the natural map is below 1e-4 of the
+/// - crossover: once the natural map is below 1e-4 of the
 ///   mean impulse and the closed set C = {y_i > g_i} changed by at most 3 contacts in an
 ///   iteration, the impulses that close C exactly, z = y + d, (A' + U U^T)_CC d = -g_C with
 ///   d the least-norm correction (conjugate gradients from zero, preconditioned by the
