@@ -21,7 +21,8 @@ Usage:
       Run a case; outputs go to DIR (default output/<case name>), see docs/outputs.md.
   tribo run CASE.prm --resume DIR [--set ...] [--quiet]
       Continue the run in DIR from its checkpoint.bin (Output/Checkpoint interval); only
-      Solver/*, Output/* and Simulation/End time may differ from the checkpointed run.
+      Solver/*, Output/*, Simulation/End time and Shear cell/Upper body prediction depth
+      may differ from the checkpointed run.
   tribo check CASE.prm [--set ...]
       Read and validate a case without running it.
   tribo study STUDY.prm [--output DIR] [--quiet]
