@@ -57,7 +57,7 @@ namespace tribo::dem
       std::vector<char>                   marked, affected, dirty;
       std::vector<Eigen::Index>           local, affected_rows, chunks;
 
-      double contact_map(const Eigen::VectorXd &y, Eigen::Index j) const;
+      double contact_map(const Eigen::VectorXd &y, Eigen::Index j, double g_n) const;
       void   relax(Eigen::VectorXd &v, Eigen::Index j, Eigen::VectorXd *also);
       bool   on_low_rank(Eigen::Index j) const;
       MapSums map_of_rows(const Eigen::VectorXd &y, Eigen::Index first, Eigen::Index last,
@@ -99,17 +99,16 @@ namespace tribo::dem
       choose_slabs();
     }
 
-    /// Contact j's natural map in N s/m, y's rows set in op: without friction
-    /// |min(y_j, g_j)| / sqrt(D_j); with friction the norm of (phi_n, phi_t) of
-    /// dem/law_residual.h in the scaled variables (unit normal diagonal, tangent diagonal
-    /// A'_tt), times the contact's scale.
-    double ApgsRun::contact_map(const Eigen::VectorXd &y, Eigen::Index j) const
+    /// Contact j's natural map in N s/m, y's rows set in op and @p g_n its normal row of
+    /// A'y + b': without friction |min(y_j, g_j)| / sqrt(D_j); with friction the norm of
+    /// (phi_n, phi_t) of dem/law_residual.h in the scaled variables (unit normal diagonal,
+    /// tangent diagonal A'_tt), times the contact's scale.
+    double ApgsRun::contact_map(const Eigen::VectorXd &y, Eigen::Index j, double g_n) const
     {
-      const Eigen::VectorXd &b = scaled.b;
       if (w == 1)
-        return std::abs(std::min(y[j], op.row_times(y, j) + b[j])) * scaled.inv_root[j];
+        return std::abs(std::min(y[j], g_n)) * scaled.inv_root[j];
       const Eigen::Index k     = 2 * j;
-      const double       g_n   = op.row_times(y, k) + b[k], g_t = op.row_times(y, k + 1) + b[k + 1];
+      const double       g_t   = op.row_times(y, k + 1) + scaled.b[k + 1];
       const double       r_law = std::max(0.0, y[k] - g_n);
       const double       bound = problem.friction * r_law;
       const double       phi_n = y[k] - r_law;
@@ -171,13 +170,12 @@ namespace tribo::dem
         {
           if (!only || (*only)[j])
             {
-              error[j] = contact_map(y, j);
+              const Eigen::Index k   = w * j;
+              const double       g_n = op.row_times(y, k) + scaled.b[k];
+              error[j]               = contact_map(y, j, g_n);
+              // u~_n = g_n sqrt(D) (m/s): its closing part times theta h.
               if (gap_tolerance > 0)
-                {
-                  // u~_n = g_n sqrt(D) (m/s): its closing part times theta h.
-                  const Eigen::Index k = w * j;
-                  gap[j] = theta_h * std::max(0.0, -(op.row_times(y, k) + scaled.b[k])) / scaled.inv_root[k];
-                }
+                gap[j] = theta_h * std::max(0.0, -g_n) / scaled.inv_root[k];
             }
           part.worst = std::max(part.worst, error[j]);
           if (gap_tolerance > 0)
