@@ -172,7 +172,7 @@ namespace tribo::coupling
                   index_in_strip[i] = strip_particles.size();
                   strip_particles.push_back(i);
                   if (row_of[i] >= rows)
-                    strip->imposed.push_back({{index_in_strip[i]}, {}, 3, {}, {}});
+                    strip->imposed.push_back({{index_in_strip[i]}, {}, 3, {}, false, {}});
                 }
             strip->state = sph::ParticleState<2>{};
             for (const unsigned int i : strip_particles)

@@ -37,6 +37,27 @@ namespace tribo::sph
       k.viscous_heating.assign(n, 0);
     }
 
+    /// Monaghan's Pi_ij (m^5/(kg s^2), as sigma/rho^2) of the pair (i, j) at separation
+    /// r = x_i - x_j (r2 = |r|^2, hij the mean smoothing length, c the longitudinal sound
+    /// speeds): for (v_i - v_j).r < 0, mu_ij = h_ij (v_i - v_j).r / (r2 + eps h_ij^2) and
+    /// Pi_ij = (-alpha cbar mu_ij + beta mu_ij^2) / rhobar, else 0. Raises @p max_mu to -mu_ij.
+    template <int dim>
+    double monaghan_pi(const ParticleState<dim> &s, unsigned int i, unsigned int j, const Tensor<1, dim> &r,
+                       double r2, double hij, const std::vector<double> &c, double alpha, double beta,
+                       double eps, double &max_mu)
+    {
+      const double vr = (s.v[i] - s.v[j]) * r;
+      if (vr >= 0)
+        return 0;
+      // mu = h vr / D and Pi = (-alpha c mu + beta mu^2) / rho, one division.
+      const double D   = r2 + eps * hij * hij;
+      const double rho = 0.5 * (s.rho[i] + s.rho[j]);
+      const double inv = 1 / (D * rho);
+      const double mu  = hij * vr * rho * inv;
+      max_mu           = std::max(max_mu, -mu);
+      return (-alpha * 0.5 * (c[i] + c[j]) * mu + beta * mu * mu) * D * inv;
+    }
+
     template <typename F>
     void parallel_for(unsigned int n, F &&f)
     {
@@ -130,6 +151,19 @@ namespace tribo::sph
                   const double scale = bf.per_unit_mass() ? 0.5 * (s.mass[i] + s.mass[j]) : 1.0;
                   fb += (scale * bf.value(dist) / dist) * r;
                 }
+              if (prm.interface_viscosity)
+                {
+                  const double hij = 0.5 * (s.h[i] + s.h[j]);
+                  const double Pi  = monaghan_pi(s, i, j, r, r2, hij, c, alpha, beta, eps, max_mu);
+                  if (Pi != 0)
+                    {
+                      const Tensor<1, dim> g   = CubicSplineKernel<dim>::gradient(r, r2, 1 / hij);
+                      const double         dvg = (s.v[i] - s.v[j]) * g;
+                      fb -= (s.mass[i] * s.mass[j] * Pi) * g;
+                      de += s.mass[j] * 0.5 * Pi * dvg;
+                      heating += s.mass[j] * 0.5 * Pi * dvg;
+                    }
+                }
               continue;
             }
           const double hij = 0.5 * (s.h[i] + s.h[j]);
@@ -141,18 +175,7 @@ namespace tribo::sph
           const double         mj = s.mass[j];
           const double         dvg = dv * g;
           drho += mj * dvg;
-          double       Pi = 0;
-          const double vr = dv * r;
-          if (vr < 0)
-            {
-              // mu = h vr / D and Pi = (-alpha c mu + beta mu^2) / rho, one division.
-              const double D   = r2 + eps * hij * hij;
-              const double rho = 0.5 * (s.rho[i] + s.rho[j]);
-              const double inv = 1 / (D * rho);
-              const double mu  = hij * vr * rho * inv;
-              Pi               = (-alpha * 0.5 * (c[i] + c[j]) * mu + beta * mu * mu) * D * inv;
-              max_mu           = std::max(max_mu, -mu);
-            }
+          const double Pi = monaghan_pi(s, i, j, r, r2, hij, c, alpha, beta, eps, max_mu);
           const SymmetricTensor<2, dim> pair = A[i] + A[j];
           acc += mj * (pair * g - Pi * g);
           de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);
@@ -192,7 +215,7 @@ namespace tribo::sph
     for (unsigned int e = 0; e < imposed.size(); ++e)
       for (unsigned int i : imposed[e].particles)
         for (unsigned int c = 0; c < dim; ++c)
-          if (imposed[e].components & (1u << c))
+          if (!imposed[e].between_steps && (imposed[e].components & (1u << c)))
             {
               k.imposed_force[e][c] -= s.mass[i] * k.dv[i][c];
               k.dv[i][c] = 0;
@@ -233,20 +256,21 @@ namespace tribo::sph
   }
 
   template <int dim>
-  void Solver<dim>::apply_imposed(ParticleState<dim> &s, double t, bool count)
+  void Solver<dim>::apply_imposed(ParticleState<dim> &s, double t, bool count, bool stage)
   {
     for (auto &iv : imposed)
-      for (unsigned int i : iv.particles)
-        {
-          const Tensor<1, dim> v = iv.field ? iv.field(s.x[i], t) : iv.velocity;
-          for (unsigned int c = 0; c < dim; ++c)
-            if (iv.components & (1u << c))
-              {
-                if (count)
-                  iv.impulse[c] += s.mass[i] * (v[c] - s.v[i][c]);
-                s.v[i][c] = v[c];
-              }
-        }
+      if (!(stage && iv.between_steps))
+        for (unsigned int i : iv.particles)
+          {
+            const Tensor<1, dim> v = iv.field ? iv.field(s.x[i], t) : iv.velocity;
+            for (unsigned int c = 0; c < dim; ++c)
+              if (iv.components & (1u << c))
+                {
+                  if (count)
+                    iv.impulse[c] += s.mass[i] * (v[c] - s.v[i][c]);
+                  s.v[i][c] = v[c];
+                }
+          }
   }
 
   template <int dim>
@@ -334,7 +358,12 @@ namespace tribo::sph
     }
     std::vector<unsigned int> worst;
     double                    dt = stable_step(state, k1, limiter, worst);
-    if (dt < prm.dt_min)
+    if (prm.fixed_step > 0)
+      {
+        dt      = prm.fixed_step;
+        limiter = "fixed";
+      }
+    else if (dt < prm.dt_min)
       {
         std::string msg = "SPH time step " + to_text(dt) + " s fell below the step floor dt_min = " +
                           to_text(prm.dt_min) + " s, limited by the " + limiter +
@@ -364,7 +393,7 @@ namespace tribo::sph
       mid.e[i] += hdt * k1.de[i];
       mid.S[i] += hdt * k1.dS[i];
     });
-    apply_imposed(mid, time + 0.5 * dt);
+    apply_imposed(mid, time + 0.5 * dt, false, true);
     compute_rates(mid, time + 0.5 * dt, k2);
     parallel_for(n, [&](unsigned int i) {
       state.x[i] += dt * k2.dx[i];

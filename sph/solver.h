@@ -42,6 +42,16 @@ namespace tribo::sph
     /// when c + 2 max_i |x_i - x_i(at the build)| exceeds that. The rates do not depend on
     /// it (pairs beyond c are skipped); 0 rebuilds at every evaluation.
     double neighbour_skin = 0.1;
+    /// Monaghan viscosity also between particles of different bodies (pairs within
+    /// 2 h_ij, the same Pi_ij as within a body; its force counts in Rates::boundary_force
+    /// and its heat in Rates::viscous_heating). false (default): only the boundary force
+    /// acts across bodies. The paper's friction at gamma = 0 rises with alpha, which
+    /// points to a viscosity across the interface.
+    bool interface_viscosity = false;
+    /// A fixed step, s (0: adaptive, dt = min(CFL, acceleration, dt_max)). A fixed step
+    /// ignores the stability limits (the paper's typical 5e-8 s); the run stops with a
+    /// RunError if it blows up.
+    double fixed_step = 0;
   };
 
   /// Particles whose velocity is imposed (e.g. the top layers moved
@@ -58,6 +68,11 @@ namespace tribo::sph
     Tensor<1, dim>            velocity; ///< m/s
     unsigned int              components = (1u << dim) - 1; ///< imposed components (bit mask)
     std::function<Tensor<1, dim>(const Tensor<1, dim> &x, double t)> field;
+    /// false (default): imposed at every Runge-Kutta stage (dv/dt = 0 on the imposed
+    /// components). true: imposed only after each step, a velocity reset, the particles
+    /// integrated freely within it (an explicit code's reading of "moved with velocity v";
+    /// the reset's impulse is the constraint's).
+    bool between_steps = false;
     /// Impulse the constraint has supplied (N s; N s/m in 2D), summed over steps: dt times
     /// its force at the step's midpoint (Rates::imposed_force) plus the velocity reset
     /// sum m (v_imposed - v) at the end of each step (e.g. of the damping). The owner
@@ -154,7 +169,8 @@ namespace tribo::sph
     /// One step of the midpoint Runge-Kutta scheme
     /// y* = y + dt/2 f(y, t), y' = y + dt f(y*, t + dt/2), then exact damping over
     /// dt and imposed velocities. dt = min(dt_max, @p dt_limit, CFL, acceleration
-    /// steps over all particles), evaluated with f(y, t). Returns dt.
+    /// steps over all particles), evaluated with f(y, t), or the fixed step
+    /// (SolverParameters::fixed_step). Returns dt.
     /// Throws RunError if dt < dt_min (naming the limit and the particles) or if
     /// a rate or the new state holds NaN/Inf or a non-positive density.
     double step(double dt_limit = std::numeric_limits<double>::infinity());
@@ -175,7 +191,7 @@ namespace tribo::sph
     /// The rates of the last midpoint evaluation (the ones that advanced the
     /// state): boundary forces for friction measurements, pressures.
     const Rates<dim> &last_rates() const { return k2; }
-    /// Name of the limit that set the last step ("CFL", "acceleration", "dt_max", "dt_limit").
+    /// Name of the limit that set the last step ("CFL", "acceleration", "dt_max", "dt_limit", "fixed").
     const std::string &last_limiter() const { return limiter; }
     /// The neighbour search (as of the last evaluation): every pair within the cut-off,
     /// and some beyond it (SolverParameters::neighbour_skin).
@@ -210,8 +226,9 @@ namespace tribo::sph
 
   private:
     /// Sets the imposed velocity components; with @p count, adds the reset's impulse
-    /// sum m (v_imposed - v) to each entry's ImposedVelocity::impulse.
-    void apply_imposed(ParticleState<dim> &s, double t, bool count = false);
+    /// sum m (v_imposed - v) to each entry's ImposedVelocity::impulse. At a Runge-Kutta
+    /// @p stage the entries imposed only between steps are left alone.
+    void apply_imposed(ParticleState<dim> &s, double t, bool count = false, bool stage = false);
     void apply_damping(ParticleState<dim> &s, double dt);
     void check_finite(const ParticleState<dim> &s, const std::string &where) const;
 

@@ -5,10 +5,13 @@
 
 #include "app/particle_scenes.h"
 #include "app/scenes/mlp_family.h"
+#include "app/steady_state.h"
 #include "mlp/analysis.h"
 #include "mlp/particles.h"
+#include "core/serialization.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -126,31 +129,67 @@ namespace tribo::app
           ("coordination", mean_coordination(field, p, box));
       }
 
-      /// Adds the per-particle |F_return| (net and bond mean) to the layer of each particle.
+      /// Adds the per-particle |F_return| (net and bond mean) to the layer of each particle,
+      /// and this row's contact and bulk means (RowMeans) to the rows' series.
       void sample_profile(const Particles &p, const mlp::Box &box, const mlp::ForceField &field)
       {
         std::vector<double> net, bond;
         return_force_magnitudes(field, p, box, net, bond);
+        std::vector<double> row_net(bins, 0.0), row_bond(bins, 0.0), row_n(bins, 0.0);
         for (unsigned int i = 0; i < p.size(); ++i)
           {
             const unsigned int b = std::min(bins - 1, static_cast<unsigned int>(p.position[i].y() / layer));
-            sum_net[b] += net[i];
-            sum_bond[b] += bond[i];
-            samples[b] += 1;
+            row_net[b] += net[i];
+            row_bond[b] += bond[i];
+            row_n[b] += 1;
           }
+        for (unsigned int b = 0; b < bins; ++b)
+          {
+            sum_net[b] += row_net[b];
+            sum_bond[b] += row_bond[b];
+            samples[b] += row_n[b];
+          }
+        const RowMeans m = contact_and_bulk(row_net, row_bond, row_n);
+        for (unsigned int k = 0; k < 4; ++k)
+          row_means[k].push_back(m[k]);
       }
 
-      /// Mean of @p sum over the layers whose centre is within @p half of @p y0 (m).
-      double window(const std::vector<double> &sum, double y0, double half) const
+      /// Mean of @p sum over the layers whose centre is within @p half of @p y0 (m), @p n
+      /// the particle samples per layer.
+      double window(const std::vector<double> &sum, const std::vector<double> &n, double y0, double half) const
       {
-        double v = 0, n = 0;
+        double v = 0, count = 0;
         for (unsigned int b = 0; b < bins; ++b)
           if (std::abs((b + 0.5) * layer - y0) <= half)
             {
               v += sum[b];
-              n += samples[b];
+              count += n[b];
             }
-        return n > 0 ? v / n : 0.0;
+        return count > 0 ? v / count : 0.0;
+      }
+
+      /// Mean |F_return| (N/m) at the contact and in the bulk (the mean of the two beams'
+      /// mid-planes), within 1.5 row spacings: {contact net, bulk net, contact bond, bulk bond}.
+      using RowMeans = std::array<double, 4>;
+      RowMeans contact_and_bulk(const std::vector<double> &net, const std::vector<double> &bond,
+                                const std::vector<double> &n) const
+      {
+        const double half_beam = 0.5 * ny * h_row, w = 1.5 * h_row;
+        const auto   bulk      = [&](const std::vector<double> &sum) {
+          return 0.5 * (window(sum, n, contact_y - half_beam, w) + window(sum, n, contact_y + half_beam, w));
+        };
+        return {{window(net, n, contact_y, w), bulk(net), window(bond, n, contact_y, w), bulk(bond)}};
+      }
+
+      /// Batch-means standard error of the contact-over-bulk ratio of series @p c and @p b
+      /// of row_means (the ratio formed per batch).
+      double ratio_stderr(unsigned int c, unsigned int b) const
+      {
+        std::vector<double>       ratio = batch_means(row_means[c]);
+        const std::vector<double> bulk  = batch_means(row_means[b]);
+        for (std::size_t k = 0; k < ratio.size(); ++k)
+          ratio[k] = bulk[k] > 0 ? ratio[k] / bulk[k] : 0.0;
+        return batch_standard_error(ratio);
       }
 
       void finish(const Particles &, const mlp::Box &, const mlp::ForceField &, const TimeSeries &stats,
@@ -162,13 +201,7 @@ namespace tribo::app
                            samples[b] ? sum_net[b] / samples[b] : 0.0,
                            samples[b] ? sum_bond[b] / samples[b] : 0.0, samples[b]});
         tables["profiles"] = profile;
-        const double half_beam = 0.5 * ny * h_row, w = 1.5 * h_row;
-        const double bulk_net  = 0.5 * (window(sum_net, contact_y - half_beam, w) +
-                                       window(sum_net, contact_y + half_beam, w));
-        const double bulk_bond = 0.5 * (window(sum_bond, contact_y - half_beam, w) +
-                                        window(sum_bond, contact_y + half_beam, w));
-        const double contact_net  = window(sum_net, contact_y, w);
-        const double contact_bond = window(sum_bond, contact_y, w);
+        const auto [contact_net, bulk_net, contact_bond, bulk_bond] = contact_and_bulk(sum_net, sum_bond, samples);
         results.set("contact_y", contact_y);
         results.set("f_return_net_contact", contact_net);
         results.set("f_return_net_bulk", bulk_net);
@@ -176,6 +209,8 @@ namespace tribo::app
         results.set("f_return_bond_bulk", bulk_bond);
         results.set("contact_over_bulk_bond", bulk_bond > 0 ? contact_bond / bulk_bond : 0.0);
         results.set("contact_over_bulk_net", bulk_net > 0 ? contact_net / bulk_net : 0.0);
+        results.set("contact_over_bulk_bond_stderr", ratio_stderr(2, 3));
+        results.set("contact_over_bulk_net_stderr", ratio_stderr(0, 1));
         const auto slip = stats.column("slip");
         double     amp  = 0;
         for (double v : slip)
@@ -187,9 +222,12 @@ namespace tribo::app
       /// The transverse load, the beams' displacements and the profile sums.
       void save(CheckpointOut &ar) const override
       {
-        ar << forcing << displacement << sum_net << sum_bond << samples;
+        ar << forcing << displacement << sum_net << sum_bond << samples << row_means;
       }
-      void load(CheckpointIn &ar) override { ar >> forcing >> displacement >> sum_net >> sum_bond >> samples; }
+      void load(CheckpointIn &ar) override
+      {
+        ar >> forcing >> displacement >> sum_net >> sum_bond >> samples >> row_means;
+      }
 
     private:
       CommonSettings s;
@@ -198,6 +236,7 @@ namespace tribo::app
       double pressure = 0, tau = 0, freq = 0, offset = 0, start = 0, layer = 0, h_row = 0;
       double contact_y = 0, forcing = 0, displacement[2] = {0, 0}, beam_y0[2] = {0, 0};
       std::vector<double> sum_net, sum_bond, samples;
+      std::array<std::vector<double>, 4> row_means; ///< per profile row, RowMeans' four series
     };
 
     /// The scene, its subsection "MLP beams" read.

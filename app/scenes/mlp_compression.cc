@@ -6,12 +6,14 @@
 
 #include "app/particle_scenes.h"
 #include "app/scenes/mlp_family.h"
+#include "app/steady_state.h"
 #include "mlp/analysis.h"
 #include "mlp/particles.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <vector>
 
 namespace tribo::app
@@ -220,23 +222,23 @@ namespace tribo::app
           density_snapshot(p, t); // the last map at the final time, if the run stopped early
         const auto   dh    = stats.column("delta_h");
         const auto   times = stats.column("time");
-        double       lowest = 1, late = 0;
-        unsigned int n_late = 0;
+        double              lowest = 1;
+        std::vector<double> late;
         for (std::size_t i = 0; i < dh.size(); ++i)
           {
             lowest = std::min(lowest, dh[i]);
             if (times[i] >= 0.7 * t)
-              {
-                late += dh[i];
-                ++n_late;
-              }
+              late.push_back(dh[i]);
           }
+        const std::vector<double> late_batches = batch_means(late);
         const double strain = youngs > 0 ? pressure / youngs : 0.0;
         results.set("youngs_modulus_theory", youngs);
         results.set("elastic_strain", strain);
         results.set("delta_h_elastic", 1 - strain);
         results.set("delta_h_min", lowest);
-        results.set("delta_h_late_mean", n_late ? late / n_late : dh.back());
+        results.set("delta_h_late_mean",
+                    late.empty() ? dh.back() : std::accumulate(late.begin(), late.end(), 0.0) / late.size());
+        results.set("delta_h_late_stderr", batch_standard_error(late_batches));
         results.set("delta_h_final", dh.back());
         results.set("stopped_by_stroke", stroke_end);
         results.set("longitudinal_speed_theory", c_l);

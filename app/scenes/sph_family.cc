@@ -71,6 +71,12 @@ namespace tribo::app::sph_scenes
     prm.declare_entry("CFL number", "0.3", Double(), "C in dt = C h/(c (1 + 1.2 alpha) + beta max mu), in (0, 1].");
     prm.declare_entry("Step floor", "1e-12", Double(),
                       "Smallest allowed step, s (> 0): a smaller one ends the run with status failed.");
+    prm.declare_entry("Fixed step", "0", Double(),
+                      "A fixed step, s (>= 0; 0: adaptive, CFL and acceleration limits). A fixed step ignores "
+                      "those limits (Maveyraud et al.'s typical step is 5e-8 s); a run that blows up ends failed.");
+    prm.declare_entry("Interface viscosity", "false", dealii::Patterns::Bool(),
+                      "true: the Monaghan viscosity also acts between particles of different bodies (within "
+                      "2 h, counted in the boundary force); false: only the boundary force acts across bodies.");
   }
 
   sph::SolverParameters read_integration(EntryReader &r, const std::string &section)
@@ -80,6 +86,8 @@ namespace tribo::app::sph_scenes
     s.beta    = r.number(section + "Artificial viscosity beta", is_non_negative, "beta >= 0");
     s.courant = r.number(section + "CFL number", [](double v) { return v > 0 && v <= 1; }, "a CFL number in (0, 1]");
     s.dt_min  = r.number(section + "Step floor", is_positive, "a positive step floor in s");
+    s.fixed_step = r.number(section + "Fixed step", is_non_negative, "a step >= 0 in s (0: adaptive)");
+    s.interface_viscosity = r.text(section + "Interface viscosity") == "true";
     return s;
   }
 

@@ -62,7 +62,8 @@ namespace tribo::app::sph_scenes
 
   /// Declare, in the current subsection, the entries of the explicit integration that
   /// every SPH scene has: Artificial viscosity alpha and beta (Monaghan), CFL number C
-  /// (dt = C h / (c (1 + 1.2 alpha) + beta max mu)) and Step floor (s).
+  /// (dt = C h / (c (1 + 1.2 alpha) + beta max mu)), Step floor (s), Fixed step (s, 0:
+  /// adaptive) and Interface viscosity (the viscosity across bodies).
   void declare_integration_entries(dealii::ParameterHandler &prm);
 
   /// Read those entries of subsection @p section ("SPH plate/") into a solver's

@@ -61,7 +61,8 @@ namespace tribo::app
       double                gamma = 0, settling_gamma = 0;
       bool                  damping_to_sliding_velocity = true;
       unsigned int          driven_layers = 1;
-      sph::SolverParameters integration; ///< viscosity, CFL number, step floor
+      bool                  drive_reset = false; ///< Drive = reset: v_x = V set after each step only
+      sph::SolverParameters integration; ///< viscosity, CFL number, step floor, fixed step
       double                stiffness_factor = 1, range_ratio = 1;
       bool                  rest_on_tips = false;
       Surface               surface = Surface::periodic;
@@ -95,6 +96,7 @@ namespace tribo::app
       p.settling_gamma = r.number(s + "Settling gamma", is_non_negative, "a damping rate >= 0 in 1/s");
       p.damping_to_sliding_velocity = r.text(s + "Damping reference") == "sliding velocity";
       p.driven_layers = static_cast<unsigned int>(r.integer(s + "Driven layers", 1, "an integer >= 1"));
+      p.drive_reset   = r.text(s + "Drive") == "reset";
       p.integration = read_integration(r, s);
       p.stiffness_factor = r.number(s + "Boundary stiffness factor", is_positive, "a positive factor");
       p.range_ratio = r.number(s + "Boundary range ratio", [](double v) { return v > 0 && v < 2; },
@@ -295,7 +297,8 @@ namespace tribo::app
       /// fraction, a the substrate spacing), so that the climbs and descents over the
       /// substrate's particles cancel; if N = 0, the last f (t_e - t_s). mu_mean = -sum(F_x)/sum(F_n) over it (rows are
       /// interval means over equal times), mu_std the standard deviation of the rows' mu,
-      /// mu_stderr the batch-means standard error of mu_mean (the ratio per batch).
+      /// mu_stderr the standard error of mu_mean from batch means, each batch a whole lattice
+      /// period when the window holds 3 or more (mu_stderr_batches says which).
       void summarize(const TimeSeries &stats, double t_end, JsonObject &res) const override
       {
         const auto   t       = stats.column("time");
@@ -317,19 +320,39 @@ namespace tribo::app
         res.set("mu_mean", fn_mean > 0 ? -sign * mean_of(fx, rows) / fn_mean : 0.0);
         res.set("mu_std", std_of(stats.column("mu"), rows));
         {
-          // Batch means (steady_state.h) of the window's rows in time order, the ratio
-          // formed per batch as for mu_mean.
-          std::vector<double> fx_rows, fn_rows;
-          for (const std::size_t r : rows)
+          // With 3 or more whole lattice periods in the window, each period is a batch (the
+          // climb over the substrate's particles averages out within it); else batch means
+          // (steady_state.h) of the rows in time order, which that oscillation inflates. The
+          // ratio is formed per batch as for mu_mean.
+          std::vector<double> ratio, load;
+          if (whole >= 3)
             {
-              fx_rows.push_back(fx[r]);
-              fn_rows.push_back(fn[r]);
+              ratio.assign(static_cast<std::size_t>(whole), 0.0);
+              load.assign(ratio.size(), 0.0);
+              for (const std::size_t r : rows)
+                {
+                  const double k = std::ceil((t[r] - t0) / period * (1 - 1e-9)) - 1;
+                  const auto   b = static_cast<std::size_t>(std::clamp(k, 0.0, whole - 1));
+                  ratio[b] += fx[r];
+                  load[b] += fn[r];
+                }
             }
-          std::vector<double>       ratio = batch_means(fx_rows);
-          const std::vector<double> load  = batch_means(fn_rows);
+          else
+            {
+              std::vector<double> fx_rows, fn_rows;
+              for (const std::size_t r : rows)
+                {
+                  fx_rows.push_back(fx[r]);
+                  fn_rows.push_back(fn[r]);
+                }
+              ratio = batch_means(fx_rows);
+              load  = batch_means(fn_rows);
+            }
           for (std::size_t b = 0; b < ratio.size(); ++b)
             ratio[b] = load[b] > 0 ? -sign * ratio[b] / load[b] : 0.0;
           res.set("mu_stderr", batch_standard_error(ratio));
+          res.set("mu_stderr_batches", whole >= 3 ? "lattice periods" : "rows (fewer than 3 lattice periods: "
+                                                                        "inflated by the climb over the substrate)");
         }
         res.set("mu_rows_mean", mean_of(stats.column("mu"), rows));
         res.set("normal_force_mean", fn_mean);
@@ -572,11 +595,10 @@ namespace tribo::app
         set_damping(solver, p.gamma, true);
       }
 
-      /// The drive: v_x = V imposed on the driven particles by the solver at every
-      /// Runge-Kutta stage, their other components free. (Imposed only between steps, the
-      /// stiff forces of the layer below slowed them within each step, and the stress
-      /// they built in the block saturated where the midpoint lost the velocity jump:
-      /// about 2 rho a V / dt, 2e7 Pa at 0.1 m/s.)
+      /// The drive: v_x = V imposed on the driven particles, their other components free:
+      /// by the solver at every Runge-Kutta stage (Drive = exact), or set after each step
+      /// only (Drive = reset, sph::ImposedVelocity::between_steps), the driven particles then
+      /// slowed by the layer below within each step.
       void install_drive(sph::Solver<dim> &solver)
       {
         sph::ImposedVelocity<dim> push;
@@ -584,6 +606,7 @@ namespace tribo::app
         push.velocity   = vertical<dim>(0);
         push.velocity[0] = p.velocity;
         push.components = 1; // x imposed, the others free
+        push.between_steps = p.drive_reset;
         drive           = static_cast<int>(solver.imposed.size());
         solver.imposed.push_back(push);
       }
@@ -673,6 +696,11 @@ namespace tribo::app
                       "Number of top layers of the block whose horizontal velocity is imposed (vertical free), >= 1. "
                       "The paper drives the first and sometimes the second layer; the block follows either "
                       "(2D quick case: mu 0.0025 with one, 0.0012 with two; docs/validation.md).");
+    prm.declare_entry("Drive", "exact", Selection("exact|reset"),
+                      "How the driven layers move at V: 'exact' imposes v_x = V at every Runge-Kutta stage (the "
+                      "constraint's force balances the block); 'reset' integrates them with the others and sets "
+                      "v_x = V after each step (an explicit code's reading of the paper's 'moved with velocity v'; "
+                      "the resets' impulse is the drive's).");
     declare_integration_entries(prm);
     prm.declare_entry("Boundary stiffness factor", "1",  Double(),
                       "k in the spring law f1 between the bodies, K = k E a^(dim-2) (N/m in 3D, N/m per m "

@@ -7,7 +7,10 @@
 - a slab pressed between two platens oscillates elastically about a width near the
   elastic estimate 1 - P/E below a critical load, and flows plastically (delta_h far
   below the elastic estimate, down to the stroke limit) above it: the critical load is
-  bracketed between two loads;
+  bracketed between two loads; the late mean width carries its batch-means standard
+  error, recomputed here from the statistics;
+- two rubbed beams: the contact-over-bulk |F_return| ratio equals the one recomputed
+  from profiles.csv, with a positive batch-means standard error below half of it;
 - random particles order into a lattice whose structure factor has six peaks 60 degrees
   apart (n = 6, at 30 + 60 k degrees for rows along x) or four 90 degrees apart (n = 4,
   at 0 + 90 k degrees) on the first Bragg ring;
@@ -134,6 +137,15 @@ class Compression(unittest.TestCase):
         crossings = np.count_nonzero(np.diff(np.sign(late - mean)) != 0)
         self.assertGreaterEqual(crossings, 6)
         self.assertFalse(r["stopped_by_stroke"])
+        # summary's late mean (t >= 0.7 t_end) and its batch-means standard error: 10
+        # contiguous batches of the rows, sqrt(sum (m_b - m)^2 / (B (B - 1))).
+        rows = st["delta_h"][st["time"] >= 0.7 * st["time"][-1]]
+        n = len(rows)
+        batches = np.array([rows[b * n // 10:(b + 1) * n // 10].mean() for b in range(10)])
+        se = math.sqrt(((batches - batches.mean()) ** 2).sum() / (10 * 9))
+        self.assertAlmostEqual(r["delta_h_late_mean"], rows.mean(), delta=1e-12)
+        self.assertAlmostEqual(r["delta_h_late_stderr"], se, delta=1e-9 * se)
+        self.assertGreater(se, 0)
         print("\n  P = %g Pa: P/E = %.4f, late delta_h %.4f (1 - %.2f P/E), min %.4f, %d crossings" %
               (self.LOW, strain, mean, (1 - mean) / strain, st["delta_h"].min(), crossings))
 
@@ -222,6 +234,42 @@ class Ordering(unittest.TestCase):
 
     def test_square_order_has_four_peaks_90_degrees_apart(self):
         self.check("square", 4, 0.0)
+
+
+class Beams(unittest.TestCase):
+    """cases/mlp/beams.prm (two beams of 32 x 12 rubbed, 1 us, about 3 s)."""
+
+    def test_contact_over_bulk_from_the_profile_with_its_standard_error(self):
+        with tempfile.TemporaryDirectory() as d:
+            case = os.path.join(os.path.dirname(__file__), "..", "..", "cases", "mlp", "beams.prm")
+            out = os.path.join(d, "beams")
+            p = subprocess.run([TRIBO, "run", case, "--output", out, "--quiet", "--set", "Output/Plots=false"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(os.path.join(out, "summary.json")) as f:
+                r = json.load(f)["results"]
+            with open(os.path.join(out, "profiles.csv")) as f:
+                rows = list(csv.DictReader(f))
+            prof = {k: np.array([float(x[k]) for x in rows]) for k in rows[0]}
+        # The window means: layers within 1.5 row spacings of the contact and of each beam's
+        # mid-plane (12 rows of sqrt(3)/2 r0 per beam), weighted by their samples.
+        h_row = prof["y"][1] - prof["y"][0]  # Layer thickness = 1 row spacing
+        half_beam = 0.5 * 12 * h_row
+
+        def window(column, y0):
+            sel = np.abs(prof["y_from_contact"] - y0) <= 1.5 * h_row + 1e-12 * h_row
+            n = prof["n_samples"][sel]
+            return (prof[column][sel] * n).sum() / n.sum()
+
+        for kind in ("net", "bond"):
+            column = "f_return_" + kind
+            bulk = 0.5 * (window(column, -half_beam) + window(column, half_beam))
+            ratio = window(column, 0.0) / bulk
+            self.assertAlmostEqual(r["contact_over_bulk_" + kind], ratio, delta=1e-9 * ratio)
+            se = r["contact_over_bulk_%s_stderr" % kind]
+            print("\n  contact / bulk |F_return| (%s): %.3f +/- %.3f" % (kind, ratio, se))
+            self.assertGreater(se, 0)
+            self.assertLess(se, 0.5 * ratio)
 
 
 class Control(unittest.TestCase):
