@@ -234,6 +234,63 @@ def row_laws(runs):
             "not rerun converged")
 
 
+PAPER_SPH_ERROR = 0.01  # Maveyraud et al.'s eq. (50): mu ~ 0.06 +/- 0.01
+DRIVES = (("exact", "exact drive"), ("reset", "reset drive"))
+
+
+def sph_case(runs, name, **values):
+    """mu_mean and mu_stderr of the complete case of study RUNS/name with @p values."""
+    row = case_where(study(runs, name), **values)
+    return None if row is None else (float(row["mu_mean"]), float(row["mu_stderr"]))
+
+
+def within(mu_se, paper):
+    """Whether mu lies within two combined errors (ours, the paper's 0.01) of @p paper."""
+    mu, se = mu_se
+    return abs(mu - paper) <= 2 * np.hypot(se, PAPER_SPH_ERROR)
+
+
+def sph_verdict(results, paper):
+    """'reproduced under a reading' naming the drives whose every figure lies within two
+    combined errors of the paper's (@p results: drive -> list of (mu, se), @p paper: the
+    paper's values in the same order), else 'not reproduced'."""
+    good = [label for drive, label in DRIVES
+            if results.get(drive) and all(within(r, v) for r, v in zip(results[drive], paper))]
+    if good:
+        return "reproduced under a reading: the " + " and the ".join(good)
+    return "not reproduced by either drive (within two errors of the paper's, its own +/- 0.01 included)"
+
+
+def sph_row(cases, paper):
+    """A row over both drives: @p cases(runs, drive) gives the (label, study, values) of each
+    figure; the text lists them per drive, the verdict compares with @p paper."""
+    def row(runs):
+        texts, results = [], {}
+        for drive, label in DRIVES:
+            figures = []
+            for text, name, values in cases(drive):
+                r = sph_case(runs, name, **values)
+                if r is None:
+                    return None
+                figures.append((text, r))
+            results[drive] = [r for _, r in figures]
+            texts.append(label + ": " + ", ".join(f"{t} {pm(*r, digits=3)}" for t, r in figures))
+        return "; ".join(texts), sph_verdict(results, paper)
+    return row
+
+
+def numerics(gamma, drive, interface="false"):
+    return ("sph_numerics", dict(SPH_slider__Gamma=gamma, SPH_slider__Drive=drive,
+                                 SPH_slider__Interface_viscosity=interface))
+
+
+row_sph_flat = sph_row(lambda d: [("gamma 1e6", *numerics("1e6", d)), ("1e8", *numerics("1e8", d))], (0.06, 0.06))
+row_sph_table = sph_row(lambda d: [("alpha 0, gamma 0", "sph_table", dict(SPH_slider__Drive=d)),
+                                   ("alpha 0.1, gamma 0", *numerics("0", d)),
+                                   ("alpha 0.1, gamma 1e6", *numerics("1e6", d))], (0.021, 0.031, 0.050))
+row_sph_fast = sph_row(lambda d: [("10 m/s", "sph_fast", dict(SPH_slider__Drive=d))], (0.11,))
+
+
 def settled_elsewhere(text, where):
     """A row whose current figure was not made at this table's settings."""
     return lambda runs: (f"{text} ({where})", "not settled by a run of this table")
@@ -279,12 +336,14 @@ ROWS = [
     (CAO, "Figs. 11-12", "velocity accommodation with the first body's stiffness", "more in the softer body",
      "cases/shear/deformable_matched.prm",
      settled_elsewhere("at the solve settings of 2026-11-27", "docs/validation.md, first-body models")),
-    (MAVEYRAUD, "Table, Fig.", "mu at 1e8 Pa, 1 m/s, flat over gamma = 1e6-1e9", "0.06",
-     "cases/sph_slider/", settled_elsewhere("0.0005, 0.0022, 0.040 at gamma = 0, 1e6, 1e8 (3D, half resolution); "
-                                            "0.0087 at 1e6 at the paper's resolution", "docs/validation.md")),
-    (MAVEYRAUD, "Table", "mu at gamma = 0, alpha = 0; mu_l at alpha = 0.1", "0.020; 0.031", "cases/sph_slider/",
-     settled_elsewhere("not run", "issue 50")),
-    (MAVEYRAUD, "text", "mu at 10 m/s", "0.11", "cases/sph_slider/", settled_elsewhere("not run", "issue 50")),
+    (MAVEYRAUD, "eq. 50, Table", "mu_l at 1e8 Pa, 1 m/s, alpha = 0.1, flat over gamma = 1e6-1e9", "0.06 +/- 0.01",
+     "build/bin/tribo study cases/sph_slider/study_numerics.prm --output RUNS/sph_numerics (3D, half resolution)",
+     row_sph_flat),
+    (MAVEYRAUD, "Table", "mu_l at (alpha, gamma) = (0, 0), (0.1, 0), (0.1, 1e6)", "0.021, 0.031, 0.050",
+     "build/bin/tribo study cases/sph_slider/study_table.prm --output RUNS/sph_table (and sph_numerics)",
+     row_sph_table),
+    (MAVEYRAUD, "text, Fig. 6", "mu_l at 10 m/s (alpha = 0.1, gamma = 1e6)", "0.11",
+     "build/bin/tribo study cases/sph_slider/study_fast.prm --output RUNS/sph_fast", row_sph_fast),
     (POPOV, "Fig. 2", "ordering of random particles; lattice symmetry of the structure factor",
      "hexagonal / square peaks", "build/bin/tribo run cases/mlp/ordering_hex.prm (ordering_square.prm)",
      documented("A_6 = 0.882 (hex), A_4 = 0.876 (square)", "docs/validation.md", "reproduced")),

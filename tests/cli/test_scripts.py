@@ -237,6 +237,23 @@ class Reproduction(TempDirTestCase):
         self.assertTrue(ours.endswith("at the paper's size (3820 grains), interior point 1e-8: 11.64 +/- 0.1 MPa "
                                       "(mu 0.1164 +/- 0.001)"), ours)
 
+    def test_the_sph_friction_verdict_names_the_drive_within_two_combined_errors(self):
+        # mu_l 0.06 +/- 0.01 (the paper's) against the reset drive's 0.075 +/- 0.005 at both
+        # gamma: |diff| 0.015 < 2 hypot(0.005, 0.01) = 0.022, reproduced; the exact drive's
+        # 0.002 is not.
+        os.makedirs(os.path.join(self.tmp, "sph_numerics"))
+        rows = ["case,SPH slider/Gamma,SPH slider/Drive,SPH slider/Interface viscosity,status,mu_mean,mu_stderr"]
+        for k, (gamma, drive, mu) in enumerate([("1e6", "exact", 0.002), ("1e8", "exact", 0.04),
+                                               ("1e6", "reset", 0.075), ("1e8", "reset", 0.075)]):
+            rows.append("%d,%s,%s,false,complete,%r,0.005" % (k, gamma, drive, mu))
+        with open(os.path.join(self.tmp, "sph_numerics", "study_summary.csv"), "w") as f:
+            f.write("\n".join(rows) + "\n")
+        ours, verdict = reproduction_rows(reproduction(self.tmp).stdout)[
+            "mu_l at 1e8 Pa, 1 m/s, alpha = 0.1, flat over gamma = 1e6-1e9"]
+        self.assertEqual(ours, "exact drive: gamma 1e6 0.002 +/- 0.005, 1e8 0.04 +/- 0.005; "
+                               "reset drive: gamma 1e6 0.075 +/- 0.005, 1e8 0.075 +/- 0.005")
+        self.assertEqual(verdict, "reproduced under a reading: the reset drive")
+
     def test_a_load_two_errors_off_is_not_reproduced(self):
         write_reference(self.tmp, 100.3, 0.1)
         rows = reproduction_rows(reproduction(self.tmp).stdout)
