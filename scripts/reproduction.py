@@ -239,13 +239,18 @@ DRIVES = (("exact", "exact drive"), ("reset", "reset drive"))
 
 
 def sph_case(runs, name, **values):
-    """mu_mean and mu_stderr of the complete case of study RUNS/name with @p values."""
+    """mu_mean and mu_stderr of the case of study RUNS/name with @p values, "failed" when
+    that case failed, None when the study or the case is not there."""
     row = case_where(study(runs, name), **values)
-    return None if row is None else (float(row["mu_mean"]), float(row["mu_stderr"]))
+    if row is None or row.get("status") not in ("complete", "failed"):
+        return None
+    return "failed" if row["status"] == "failed" else (float(row["mu_mean"]), float(row["mu_stderr"]))
 
 
 def within(mu_se, paper):
     """Whether mu lies within two combined errors (ours, the paper's 0.01) of @p paper."""
+    if mu_se == "failed":
+        return False
     mu, se = mu_se
     return abs(mu - paper) <= 2 * np.hypot(se, PAPER_SPH_ERROR)
 
@@ -274,7 +279,8 @@ def sph_row(cases, paper):
                     return None
                 figures.append((text, r))
             results[drive] = [r for _, r in figures]
-            texts.append(label + ": " + ", ".join(f"{t} {pm(*r, digits=3)}" for t, r in figures))
+            texts.append(label + ": " + ", ".join(
+                f"{t} {'failed (the block breaks up)' if r == 'failed' else pm(*r, digits=3)}" for t, r in figures))
         return "; ".join(texts), sph_verdict(results, paper)
     return row
 
