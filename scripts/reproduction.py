@@ -126,6 +126,11 @@ def row_sigma_xy_without_cohesion(runs):
         ours += (f"; at the paper's size (3820 grains), interior point 1e-8: "
                  f"{pm(paper_size['sigma_xy_mean'], paper_size['sigma_xy_stderr'], MPA)} MPa "
                  f"(mu {pm(paper_size['mu_mean'], paper_size['mu_stderr'])})")
+    fine_step = case_where(study(runs, "tradeoff_paper_step"), knob="reference")
+    if fine_step is not None and fine_step["status"] == "complete":
+        ours += (f"; at h = 2e-9 s (APGS 3e-5, within one error of converged): "
+                 f"{pm(fine_step['sigma_xy_mean'], fine_step['sigma_xy_stderr'], MPA)} MPa "
+                 f"(mu {pm(fine_step['mu_mean'], fine_step['mu_stderr'])})")
     return (ours, verdict)
 
 

@@ -236,6 +236,14 @@ class Reproduction(TempDirTestCase):
         ours = reproduction_rows(reproduction(self.tmp).stdout)["sigma_xy without cohesion (IQS, 100 MPa, 5 m/s)"][0]
         self.assertTrue(ours.endswith("at the paper's size (3820 grains), interior point 1e-8: 11.64 +/- 0.1 MPa "
                                       "(mu 0.1164 +/- 0.001)"), ours)
+        # and the paper's sample at the finer step, when its ladder has run
+        os.makedirs(os.path.join(self.tmp, "tradeoff_paper_step"))
+        with open(os.path.join(self.tmp, "tradeoff_paper_step", "study_summary.csv"), "w") as f:
+            f.write("case,knob,value,status,mu_mean,mu_stderr,sigma_xy_mean,sigma_xy_stderr,directory\n"
+                    "0,reference,x,complete,0.1096,0.0008,10.98e6,5e4,case_000\n")
+        ours = reproduction_rows(reproduction(self.tmp).stdout)["sigma_xy without cohesion (IQS, 100 MPa, 5 m/s)"][0]
+        self.assertTrue(ours.endswith("; at h = 2e-9 s (APGS 3e-5, within one error of converged): 10.98 +/- 0.05 MPa "
+                                      "(mu 0.1096 +/- 0.0008)"), ours)
 
     def test_the_sph_friction_verdict_names_the_drive_within_two_combined_errors(self):
         # mu_l 0.06 +/- 0.01 (the paper's) against the reset drive's 0.075 +/- 0.005 at both
