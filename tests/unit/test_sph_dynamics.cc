@@ -32,6 +32,27 @@ namespace
   }
 
   const Material rock = Material::linear(2700, 26.7e9, 22.7e9);
+
+  /// A 2D granite block of 8 x 4 particles (a = 5e-4 m) at rest whose top two layers (y >
+  /// 2a) move along x at @p V, imposed on x only (the other components free), at every
+  /// stage or, with @p between_steps, as a reset after each step.
+  Solver<2> pushed_block(double V, bool between_steps)
+  {
+    const double a = 5e-4;
+    auto s = make_block<2>(vec<2>(8 * a, 4 * a), a, LatticeType::cubic, SolverParameters(), Material::granite());
+    ImposedVelocity<2> push;
+    for (unsigned int i = 0; i < s.state.size(); ++i)
+      if (s.state.x[i][1] > 2 * a)
+        {
+          push.particles.push_back(i);
+          s.state.v[i][0] = V;
+        }
+    push.velocity      = vec<2>(V, 0);
+    push.components    = 1;
+    push.between_steps = between_steps;
+    s.imposed.push_back(push);
+    return s;
+  }
 } // namespace
 
 TEST(SphDynamics, MomentumConservedToRoundOffWithRandomVelocities)
@@ -378,20 +399,8 @@ TEST(SphDynamics, ImposedComponentMovesExactlyAndItsImpulseIsTheMomentumGiven)
   // A block at rest whose top two layers are pushed along x at V (x imposed, the other
   // components free), no damping: the x momentum the free particles gain is the
   // impulse the constraint reports, and the pushed layers advance by exactly V t.
-  SolverParameters prm;
-  const double     a = 5e-4, V = 0.1;
-  auto s = make_block<2>(vec<2>(8 * a, 4 * a), a, LatticeType::cubic, prm, Material::granite());
-  ImposedVelocity<2> push;
-  // Layers at y = 0.5, 1.5, 2.5, 3.5 a: the top two pushed.
-  for (unsigned int i = 0; i < s.state.size(); ++i)
-    if (s.state.x[i][1] > 2 * a)
-      {
-        push.particles.push_back(i);
-        s.state.v[i][0] = V;
-      }
-  push.velocity   = vec<2>(V, 0);
-  push.components = 1;
-  s.imposed.push_back(push);
+  const double a = 5e-4, V = 0.1;
+  auto         s = pushed_block(V, false);
   const auto   x0 = s.state.x;
   const double t  = 2e-6;
   s.advance_to(t);
@@ -414,22 +423,11 @@ TEST(SphDynamics, ImposedBetweenStepsIsAResetWhoseImpulseIsTheMomentumGiven)
   // between_steps): within a step the pushed layers are slowed by the free ones, so they
   // advance less than V t, end each step at exactly V, and the resets' impulse is all the
   // x momentum the block has gained.
-  SolverParameters prm;
-  const double     a = 5e-4, V = 0.1;
-  auto s = make_block<2>(vec<2>(8 * a, 4 * a), a, LatticeType::cubic, prm, Material::granite());
-  ImposedVelocity<2> push;
-  double             p0 = 0;
-  for (unsigned int i = 0; i < s.state.size(); ++i)
-    if (s.state.x[i][1] > 2 * a)
-      {
-        push.particles.push_back(i);
-        s.state.v[i][0] = V;
-        p0 += s.state.mass[i] * V;
-      }
-  push.velocity      = vec<2>(V, 0);
-  push.components    = 1;
-  push.between_steps = true;
-  s.imposed.push_back(push);
+  const double a = 5e-4, V = 0.1;
+  auto         s  = pushed_block(V, true);
+  double       p0 = 0;
+  for (unsigned int i : s.imposed[0].particles)
+    p0 += s.state.mass[i] * V;
   const auto   x0 = s.state.x;
   const double t  = 2e-6;
   s.advance_to(t);
