@@ -187,6 +187,14 @@ def write_reference(runs, sigma_yy, sigma_yy_stderr):
             f.write("%r,%r\n" % (i * 1e-7, 6e-10 if i < 10 else -1.2e-10))
 
 
+def write_paper_reference(runs, name, figures):
+    """A tradeoff RUNS/name whose reference has @p figures: "mu,mu_se,sigma_xy,sigma_xy_se"."""
+    os.makedirs(os.path.join(runs, name))
+    with open(os.path.join(runs, name, "study_summary.csv"), "w") as f:
+        f.write("case,knob,value,status,mu_mean,mu_stderr,sigma_xy_mean,sigma_xy_stderr,directory\n"
+                "0,reference,x,complete,%s,case_000\n" % figures)
+
+
 def reproduction_rows(stdout):
     """{quantity: (ours, verdict)} of the table."""
     rows = [line.split(" | ") for line in stdout.splitlines() if line.startswith("| ") and "---" not in line]
@@ -229,18 +237,12 @@ class Reproduction(TempDirTestCase):
 
     def test_the_paper_size_reference_joins_the_friction_row(self):
         write_reference(self.tmp, 100.0, 0.1)
-        os.makedirs(os.path.join(self.tmp, "tradeoff_paper_solver"))
-        with open(os.path.join(self.tmp, "tradeoff_paper_solver", "study_summary.csv"), "w") as f:
-            f.write("case,knob,value,status,mu_mean,mu_stderr,sigma_xy_mean,sigma_xy_stderr,directory\n"
-                    "0,reference,x,complete,0.1164,0.001,11.64e6,1e5,case_000\n")
+        write_paper_reference(self.tmp, "tradeoff_paper_solver", "0.1164,0.001,11.64e6,1e5")
         ours = reproduction_rows(reproduction(self.tmp).stdout)["sigma_xy without cohesion (IQS, 100 MPa, 5 m/s)"][0]
         self.assertTrue(ours.endswith("at the paper's size (3820 grains), interior point 1e-8: 11.64 +/- 0.1 MPa "
                                       "(mu 0.1164 +/- 0.001)"), ours)
         # and the paper's sample at the finer step, when its ladder has run
-        os.makedirs(os.path.join(self.tmp, "tradeoff_paper_step"))
-        with open(os.path.join(self.tmp, "tradeoff_paper_step", "study_summary.csv"), "w") as f:
-            f.write("case,knob,value,status,mu_mean,mu_stderr,sigma_xy_mean,sigma_xy_stderr,directory\n"
-                    "0,reference,x,complete,0.1096,0.0008,10.98e6,5e4,case_000\n")
+        write_paper_reference(self.tmp, "tradeoff_paper_step", "0.1096,0.0008,10.98e6,5e4")
         ours = reproduction_rows(reproduction(self.tmp).stdout)["sigma_xy without cohesion (IQS, 100 MPa, 5 m/s)"][0]
         self.assertTrue(ours.endswith("; at h = 2e-9 s (APGS 3e-5, within one error of converged): 10.98 +/- 0.05 MPa "
                                       "(mu 0.1096 +/- 0.0008)"), ours)
