@@ -37,16 +37,17 @@ namespace tribo::sph
       k.viscous_heating.assign(n, 0);
     }
 
-    /// Monaghan's Pi_ij (m^5/(kg s^2), as sigma/rho^2) of the pair (i, j) at separation
-    /// r = x_i - x_j (r2 = |r|^2, hij the mean smoothing length, c the longitudinal sound
-    /// speeds): for (v_i - v_j).r < 0, mu_ij = h_ij (v_i - v_j).r / (r2 + eps h_ij^2) and
-    /// Pi_ij = (-alpha cbar mu_ij + beta mu_ij^2) / rhobar, else 0. Raises @p max_mu to -mu_ij.
+    /// Monaghan's Pi_ij (m^5/(kg s^2), as sigma/rho^2) of the pair (i, j) with velocity
+    /// difference dv = v_i - v_j at separation r = x_i - x_j (r2 = |r|^2, hij the mean
+    /// smoothing length, c the longitudinal sound speeds): for dv.r < 0,
+    /// mu_ij = h_ij dv.r / (r2 + eps h_ij^2) and Pi_ij = (-alpha cbar mu_ij + beta mu_ij^2) /
+    /// rhobar, else 0. Raises @p max_mu to -mu_ij.
     template <int dim>
-    double monaghan_pi(const ParticleState<dim> &s, unsigned int i, unsigned int j, const Tensor<1, dim> &r,
-                       double r2, double hij, const std::vector<double> &c, double alpha, double beta,
-                       double eps, double &max_mu)
+    double monaghan_pi(const ParticleState<dim> &s, unsigned int i, unsigned int j, const Tensor<1, dim> &dv,
+                       const Tensor<1, dim> &r, double r2, double hij, const std::vector<double> &c, double alpha,
+                       double beta, double eps, double &max_mu)
     {
-      const double vr = (s.v[i] - s.v[j]) * r;
+      const double vr = dv * r;
       if (vr >= 0)
         return 0;
       // mu = h vr / D and Pi = (-alpha c mu + beta mu^2) / rho, one division.
@@ -151,14 +152,15 @@ namespace tribo::sph
                   const double scale = bf.per_unit_mass() ? 0.5 * (s.mass[i] + s.mass[j]) : 1.0;
                   fb += (scale * bf.value(dist) / dist) * r;
                 }
-              if (prm.interface_viscosity)
+              const double hij = 0.5 * (s.h[i] + s.h[j]);
+              if (prm.interface_viscosity && r2 < 4 * hij * hij)
                 {
-                  const double hij = 0.5 * (s.h[i] + s.h[j]);
-                  const double Pi  = monaghan_pi(s, i, j, r, r2, hij, c, alpha, beta, eps, max_mu);
+                  const Tensor<1, dim> dv = s.v[i] - s.v[j];
+                  const double         Pi = monaghan_pi(s, i, j, dv, r, r2, hij, c, alpha, beta, eps, max_mu);
                   if (Pi != 0)
                     {
                       const Tensor<1, dim> g   = CubicSplineKernel<dim>::gradient(r, r2, 1 / hij);
-                      const double         dvg = (s.v[i] - s.v[j]) * g;
+                      const double         dvg = dv * g;
                       fb -= (s.mass[i] * s.mass[j] * Pi) * g;
                       de += s.mass[j] * 0.5 * Pi * dvg;
                       heating += s.mass[j] * 0.5 * Pi * dvg;
@@ -175,7 +177,7 @@ namespace tribo::sph
           const double         mj = s.mass[j];
           const double         dvg = dv * g;
           drho += mj * dvg;
-          const double Pi = monaghan_pi(s, i, j, r, r2, hij, c, alpha, beta, eps, max_mu);
+          const double Pi = monaghan_pi(s, i, j, dv, r, r2, hij, c, alpha, beta, eps, max_mu);
           const SymmetricTensor<2, dim> pair = A[i] + A[j];
           acc += mj * (pair * g - Pi * g);
           de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);

@@ -216,8 +216,9 @@ namespace tribo::app
       }
 
       /// Work of the pressure over the step, W += F_i(t + dt/2) . (v_i + v_i')/2 dt;
-      /// the drive's impulse over the step (N s, the solver's constraint v_x = V on the
-      /// driven particles at every Runge-Kutta stage) and its work, V times it;
+      /// the drive's impulse over the step (N s, what the solver's constraint v_x = V on the
+      /// driven particles supplied: at every Runge-Kutta stage, or as the reset after the
+      /// step with Drive = reset) and its work, V times it;
       /// interval sums of the contact forces (midpoint rates) weighted by dt.
       void after_step(sph::Solver<dim> &solver, double dt) override
       {
