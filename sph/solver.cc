@@ -33,6 +33,7 @@ namespace tribo::sph
       k.dS.assign(n, SymmetricTensor<2, dim>());
       k.boundary_force.assign(n, Tensor<1, dim>());
       k.pressure.assign(n, 0);
+      k.velocity_moment.resize(n);
       k.signal.assign(n, 0);
       k.viscous_heating.assign(n, 0);
     }
@@ -43,7 +44,7 @@ namespace tribo::sph
     /// mu_ij = h_ij dv.r / (r2 + eps h_ij^2) and Pi_ij = (-alpha cbar mu_ij + beta mu_ij^2) /
     /// rhobar, else 0. Raises @p max_mu to -mu_ij.
     template <int dim>
-    double monaghan_pi(const ParticleState<dim> &s, unsigned int i, unsigned int j, const Tensor<1, dim> &dv,
+    inline __attribute__((always_inline)) double monaghan_pi(const ParticleState<dim> &s, unsigned int i, unsigned int j, const Tensor<1, dim> &dv,
                        const Tensor<1, dim> &r, double r2, double hij, const std::vector<double> &c, double alpha,
                        double beta, double eps, double &max_mu)
     {
@@ -110,6 +111,14 @@ namespace tribo::sph
   template <int dim>
   void Solver<dim>::compute_rates(const ParticleState<dim> &s, double t, Rates<dim> &k, bool viscosity)
   {
+    evaluate<Pass::all>(s, t, k, viscosity);
+  }
+
+  template <int dim>
+  template <typename Solver<dim>::Pass pass>
+  void Solver<dim>::evaluate(const ParticleState<dim> &s, double t, Rates<dim> &k, bool viscosity)
+  {
+    constexpr bool kinematics = pass != Pass::forces, forces = pass != Pass::kinematics;
     const unsigned int n = s.size();
     resize(k, n);
     double h_max = 0;
@@ -122,11 +131,14 @@ namespace tribo::sph
     std::vector<double>                  c(n), volume(n), inv_h(n);
     std::vector<SymmetricTensor<2, dim>> A(n);
     parallel_for(n, [&](unsigned int i) {
-      const Material &m  = mats[s.material[i]];
-      const auto      ps = m.evaluate(s.rho[i], s.e[i]);
-      k.pressure[i]      = ps.pressure;
-      c[i] = std::sqrt(ps.sound_speed * ps.sound_speed + 4 * m.shear_modulus / (3 * s.rho[i]));
-      A[i] = (s.S[i] - ps.pressure * dealii::unit_symmetric_tensor<dim>()) / (s.rho[i] * s.rho[i]);
+      if constexpr (forces)
+        {
+          const Material &m  = mats[s.material[i]];
+          const auto      ps = m.evaluate(s.rho[i], s.e[i]);
+          k.pressure[i]      = ps.pressure;
+          c[i] = std::sqrt(ps.sound_speed * ps.sound_speed + 4 * m.shear_modulus / (3 * s.rho[i]));
+          A[i] = (s.S[i] - ps.pressure * dealii::unit_symmetric_tensor<dim>()) / (s.rho[i] * s.rho[i]);
+        }
       volume[i] = s.mass[i] / s.rho[i];
       inv_h[i]  = 1 / s.h[i];
     });
@@ -137,7 +149,7 @@ namespace tribo::sph
     const double         eps   = prm.av_epsilon;
     parallel_for(n, [&](unsigned int i) {
       Tensor<1, dim> acc, fb;
-      Tensor<2, dim> L, M;
+      Tensor<2, dim> L, M, T;
       double         drho = 0, de = 0, heating = 0, max_mu = 0;
       for (unsigned int q = search.start[i]; q < search.start[i + 1]; ++q)
         {
@@ -146,24 +158,28 @@ namespace tribo::sph
           const double         r2 = r.norm_square();
           if (s.body[i] != s.body[j])
             {
-              if (r2 < bf_range2 && r2 > 0)
+              if constexpr (forces)
                 {
-                  const double dist  = std::sqrt(r2);
-                  const double scale = bf.per_unit_mass() ? 0.5 * (s.mass[i] + s.mass[j]) : 1.0;
-                  fb += (scale * bf.value(dist) / dist) * r;
-                }
-              const double hij = 0.5 * (s.h[i] + s.h[j]);
-              if (prm.interface_viscosity && r2 < 4 * hij * hij)
-                {
-                  const Tensor<1, dim> dv = s.v[i] - s.v[j];
-                  const double         Pi = monaghan_pi(s, i, j, dv, r, r2, hij, c, alpha, beta, eps, max_mu);
-                  if (Pi != 0)
+                  if (r2 < bf_range2 && r2 > 0)
                     {
-                      const Tensor<1, dim> g   = CubicSplineKernel<dim>::gradient(r, r2, 1 / hij);
-                      const double         dvg = dv * g;
-                      fb -= (s.mass[i] * s.mass[j] * Pi) * g;
-                      de += s.mass[j] * 0.5 * Pi * dvg;
-                      heating += s.mass[j] * 0.5 * Pi * dvg;
+                      const double dist  = std::sqrt(r2);
+                      const double scale = bf.per_unit_mass() ? 0.5 * (s.mass[i] + s.mass[j]) : 1.0;
+                      fb += (scale * bf.value(dist) / dist) * r;
+                    }
+                  const double hij = 0.5 * (s.h[i] + s.h[j]);
+                  if (prm.interface_viscosity && r2 < 4 * hij * hij)
+                    {
+                      const Tensor<1, dim> dv = s.v[i] - s.v[j];
+                      const double         Pi = monaghan_pi(s, i, j, dv, r, r2, hij, c, alpha, beta, eps, max_mu);
+                      if (Pi != 0)
+                        {
+                          const Tensor<1, dim> g   = CubicSplineKernel<dim>::gradient(r, r2, 1 / hij);
+                          const double         dvg = dv * g;
+                          fb -= (s.mass[i] * s.mass[j] * Pi) * g;
+                          if constexpr (pass == Pass::all)
+                            de += s.mass[j] * 0.5 * Pi * dvg;
+                          heating += s.mass[j] * 0.5 * Pi * dvg;
+                        }
                     }
                 }
               continue;
@@ -176,37 +192,66 @@ namespace tribo::sph
           const Tensor<1, dim> dv = s.v[i] - s.v[j];
           const double         mj = s.mass[j];
           const double         dvg = dv * g;
-          drho += mj * dvg;
-          const double Pi = monaghan_pi(s, i, j, dv, r, r2, hij, c, alpha, beta, eps, max_mu);
-          const SymmetricTensor<2, dim> pair = A[i] + A[j];
-          acc += mj * (pair * g - Pi * g);
-          de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);
-          heating += mj * 0.5 * Pi * dvg;
-          L -= volume[j] * dealii::outer_product(dv, g);
-          M -= volume[j] * dealii::outer_product(r, g);
+          if constexpr (pass == Pass::all)
+            {
+              drho += mj * dvg;
+              const double Pi = monaghan_pi(s, i, j, dv, r, r2, hij, c, alpha, beta, eps, max_mu);
+              const SymmetricTensor<2, dim> pair = A[i] + A[j];
+              acc += mj * (pair * g - Pi * g);
+              de += mj * (-(dv * (A[i] * g)) + 0.5 * Pi * dvg);
+              heating += mj * 0.5 * Pi * dvg;
+              L -= volume[j] * dealii::outer_product(dv, g);
+              M -= volume[j] * dealii::outer_product(r, g);
+            }
+          else if constexpr (pass == Pass::kinematics)
+            {
+              drho += mj * dvg;
+              T += mj * dealii::outer_product(dv, g);
+              L -= volume[j] * dealii::outer_product(dv, g);
+              M -= volume[j] * dealii::outer_product(r, g);
+            }
+          else
+            {
+              const double Pi = monaghan_pi(s, i, j, dv, r, r2, hij, c, alpha, beta, eps, max_mu);
+              const SymmetricTensor<2, dim> pair = A[i] + A[j];
+              acc += mj * (pair * g - Pi * g);
+              heating += mj * 0.5 * Pi * dvg;
+            }
         }
-      if (prm.corrected_gradient)
+      if constexpr (kinematics)
         {
-          const double det = dealii::determinant(M);
-          if (std::isfinite(det) && det > std::pow(0.05, dim))
-            L = L * dealii::invert(M);
+          if (prm.corrected_gradient)
+            {
+              const double det = dealii::determinant(M);
+              if (std::isfinite(det) && det > std::pow(0.05, dim))
+                L = L * dealii::invert(M);
+            }
+          const double G = mats[s.material[i]].shear_modulus;
+          const SymmetricTensor<2, dim> eps_dot = dealii::symmetrize(L);
+          const Tensor<2, dim>          omega   = 0.5 * (L - dealii::transpose(L));
+          const Tensor<2, dim>          S(s.S[i]);
+          const Tensor<2, dim>          rot = omega * S - S * omega;
+          k.dS[i] = 2 * G * (eps_dot - dealii::trace(eps_dot) / 3.0 * dealii::unit_symmetric_tensor<dim>()) +
+                    dealii::symmetrize(rot);
+          k.drho[i] = drho;
+          k.dx[i]   = s.v[i];
+          if constexpr (pass == Pass::kinematics)
+            k.velocity_moment[i] = T;
         }
-      const double G = mats[s.material[i]].shear_modulus;
-      const SymmetricTensor<2, dim> eps_dot = dealii::symmetrize(L);
-      const Tensor<2, dim>          omega   = 0.5 * (L - dealii::transpose(L));
-      const Tensor<2, dim>          S(s.S[i]);
-      const Tensor<2, dim>          rot = omega * S - S * omega;
-      k.dS[i] = 2 * G * (eps_dot - dealii::trace(eps_dot) / 3.0 * dealii::unit_symmetric_tensor<dim>()) +
-                dealii::symmetrize(rot);
-      k.dv[i]             = acc + fb / s.mass[i];
-      k.boundary_force[i] = fb;
-      k.drho[i]           = drho;
-      k.de[i]             = de;
-      k.viscous_heating[i] = heating;
-      k.dx[i]             = s.v[i];
-      k.signal[i]         = c[i] * (1 + 1.2 * alpha) + beta * max_mu;
+      if constexpr (pass == Pass::forces)
+        de = heating; // the viscous heat is this pass's whole share of de
+      if constexpr (forces)
+        {
+          k.dv[i]              = acc + fb / s.mass[i];
+          k.boundary_force[i]  = fb;
+          k.viscous_heating[i] = heating;
+          k.signal[i]          = c[i] * (1 + 1.2 * alpha) + beta * max_mu;
+        }
+      k.de[i] = de;
     });
 
+    if constexpr (!forces)
+      return;
     for (const auto &ef : external)
       {
         const double ramp = ef.tau > 0 ? 1 - std::exp(-t / ef.tau) : 1.0;
@@ -335,31 +380,30 @@ namespace tribo::sph
   }
 
   template <int dim>
-  double Solver<dim>::step(double dt_limit)
+  void Solver<dim>::check_rates(const Rates<dim> &k) const
   {
-    const unsigned int n = state.size();
-    apply_imposed(state, time);
-    compute_rates(state, time, k1);
-    {
-      std::vector<unsigned int> bad;
-      for (unsigned int i = 0; i < n && bad.size() < 5; ++i)
-        {
-          bool ok = std::isfinite(k1.drho[i]) && std::isfinite(k1.de[i]);
-          for (unsigned int d = 0; d < dim; ++d)
-            ok = ok && std::isfinite(k1.dv[i][d]);
-          if (!ok)
-            bad.push_back(i);
-        }
-      if (!bad.empty())
-        {
-          std::string msg = "SPH: NaN/Inf rate at t = " + to_text(time) + " s in";
-          for (unsigned int i : bad)
-            msg += " " + describe_particle(state, i) + ";";
-          throw RunError(msg);
-        }
-    }
+    std::vector<unsigned int> bad;
+    for (unsigned int i = 0; i < state.size() && bad.size() < 5; ++i)
+      {
+        bool ok = std::isfinite(k.drho[i]) && std::isfinite(k.de[i]);
+        for (unsigned int d = 0; d < dim; ++d)
+          ok = ok && std::isfinite(k.dv[i][d]);
+        if (!ok)
+          bad.push_back(i);
+      }
+    if (bad.empty())
+      return;
+    std::string msg = "SPH: NaN/Inf rate at t = " + to_text(time) + " s in";
+    for (unsigned int i : bad)
+      msg += " " + describe_particle(state, i) + ";";
+    throw RunError(msg);
+  }
+
+  template <int dim>
+  double Solver<dim>::step_size(const Rates<dim> &k, double dt_limit)
+  {
     std::vector<unsigned int> worst;
-    double                    dt = stable_step(state, k1, limiter, worst);
+    double                    dt = stable_step(state, k, limiter, worst);
     if (prm.fixed_step > 0)
       {
         dt      = prm.fixed_step;
@@ -384,6 +428,24 @@ namespace tribo::sph
         dt      = dt_limit;
         limiter = "dt_limit";
       }
+    return dt;
+  }
+
+  template <int dim>
+  double Solver<dim>::step(double dt_limit)
+  {
+    forces_current = false;
+    return prm.integrator == Integrator::leapfrog ? leapfrog_step(dt_limit) : midpoint_step(dt_limit);
+  }
+
+  template <int dim>
+  double Solver<dim>::midpoint_step(double dt_limit)
+  {
+    const unsigned int n = state.size();
+    apply_imposed(state, time);
+    compute_rates(state, time, k1);
+    check_rates(k1);
+    const double dt = step_size(k1, dt_limit);
 
     // Predictor to the midpoint.
     mid = state;
@@ -412,11 +474,82 @@ namespace tribo::sph
     heat += dt * step_heat;
     for (unsigned int e = 0; e < imposed.size(); ++e)
       imposed[e].impulse += dt * k2.imposed_force[e];
+    finish_step(dt);
+    return dt;
+  }
+
+  template <int dim>
+  double Solver<dim>::leapfrog_step(double dt_limit)
+  {
+    const unsigned int n = state.size();
+    if (!forces_current)
+      {
+        apply_imposed(state, time);
+        evaluate<Pass::forces>(state, time, k2);
+        check_rates(k2);
+      }
+    const double dt = step_size(k2, dt_limit), hdt = 0.5 * dt;
+
+    // Kick to v_{n+1/2}; the kinematic rates at the midpoint x_n + dt/2 v_{n+1/2}.
+    mid = state;
+    parallel_for(n, [&](unsigned int i) { mid.v[i] += hdt * k2.dv[i]; });
+    apply_imposed(mid, time + hdt, false, true);
+    parallel_for(n, [&](unsigned int i) { mid.x[i] += hdt * mid.v[i]; });
+    evaluate<Pass::kinematics>(mid, time + hdt, k1);
+    // Drift, and the velocity v_{n+1/2} + dt/2 a_n that the viscosity sees at the end.
+    // The stress power -A : T with A = sigma / rho^2 the mean of its values at the step's
+    // ends (A at the start alone would take the elastic energy's increment at the start's
+    // stress, an error of first order in dt that always has one sign).
+    parallel_for(n, [&](unsigned int i) {
+      const auto stress = [&](double rho, double e, const SymmetricTensor<2, dim> &S) {
+        const double P = mats[state.material[i]].evaluate(rho, e).pressure;
+        return (S - P * dealii::unit_symmetric_tensor<dim>()) / (rho * rho);
+      };
+      const Tensor<2, dim> T = k1.velocity_moment[i];
+      const Tensor<2, dim> A0((state.S[i] - k2.pressure[i] * dealii::unit_symmetric_tensor<dim>()) /
+                              (state.rho[i] * state.rho[i]));
+      state.rho[i] += dt * k1.drho[i];
+      state.S[i] += dt * k1.dS[i];
+      const double e1 = state.e[i] - dt * dealii::scalar_product(A0, T); // predictor
+      const Tensor<2, dim> A1(stress(state.rho[i], e1, state.S[i]));
+      state.e[i] += -dt * dealii::scalar_product(0.5 * (A0 + A1), T) + hdt * k2.de[i];
+      state.x[i] += dt * mid.v[i];
+      state.v[i] = mid.v[i] + hdt * k2.dv[i];
+      if (prm.period > 0)
+        state.x[i][0] -= prm.period * std::floor(state.x[i][0] / prm.period);
+    });
+    apply_imposed(state, time + dt, false, true);
+    double step_heat = 0;
+    for (unsigned int i = 0; i < n; ++i)
+      step_heat += state.mass[i] * k2.viscous_heating[i];
+    std::vector<Tensor<1, dim>> imposed_impulse(imposed.size());
+    for (unsigned int e = 0; e < imposed.size(); ++e)
+      imposed_impulse[e] = hdt * k2.imposed_force[e];
+
+    // The forces at the end, and the second kick.
+    evaluate<Pass::forces>(state, time + dt, k2);
+    check_rates(k2);
+    parallel_for(n, [&](unsigned int i) {
+      state.v[i] = mid.v[i] + hdt * k2.dv[i];
+      state.e[i] += hdt * k2.de[i];
+    });
+    for (unsigned int i = 0; i < n; ++i)
+      step_heat += state.mass[i] * k2.viscous_heating[i];
+    heat += hdt * step_heat;
+    for (unsigned int e = 0; e < imposed.size(); ++e)
+      imposed[e].impulse += imposed_impulse[e] + hdt * k2.imposed_force[e];
+    finish_step(dt);
+    forces_current = true;
+    return dt;
+  }
+
+  template <int dim>
+  void Solver<dim>::finish_step(double dt)
+  {
     apply_damping(state, dt);
     time += dt;
     apply_imposed(state, time, true);
     check_finite(state, "after the step");
-    return dt;
   }
 
   template <int dim>
@@ -445,17 +578,20 @@ namespace tribo::sph
     for (Damping &d : damping)
       ar >> d.body >> d.gamma >> d.relative_to_centre_of_mass >> d.reference_velocity;
     ar >> search.period >> search.start >> search.list >> x_at_build >> built_cutoff >> builds;
+    forces_current = false;
   }
 
   template <int dim>
   unsigned int Solver<dim>::advance_to(double t_end)
   {
     unsigned int steps = 0;
+    forces_current     = false;
     while (time < t_end * (1 - 1e-14))
       {
-        step(t_end - time);
+        prm.integrator == Integrator::leapfrog ? leapfrog_step(t_end - time) : midpoint_step(t_end - time);
         ++steps;
       }
+    forces_current = false;
     return steps;
   }
 

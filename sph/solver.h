@@ -19,9 +19,27 @@
 
 namespace tribo::sph
 {
+  /// Time integrators of Solver::step().
+  enum class Integrator
+  {
+    /// Midpoint Runge-Kutta: two evaluations of every rate per step.
+    midpoint,
+    /// Kick-drift-kick leapfrog: v_{n+1/2} = v_n + dt/2 a_n; rho, S and the stress power
+    /// of e from the velocity gradient at the midpoint x_n + dt/2 v_{n+1/2} with velocity
+    /// v_{n+1/2}; x_{n+1} = x_n + dt v_{n+1/2}; the forces a_{n+1} at the new state, the
+    /// viscosity seeing v_{n+1/2} + dt/2 a_n; v_{n+1} = v_{n+1/2} + dt/2 a_{n+1}; the
+    /// viscous heat as the mean of a_n's and a_{n+1}'s. One pass over the pairs for the
+    /// forces and one for the velocity gradient per step, the forces reused by the next
+    /// step within one advance_to(). Second order; for the elastic waves (v and S) it is
+    /// the staggered leapfrog, neutral up to omega dt = 2, where the midpoint rule grows
+    /// by (omega dt)^4 / 8 per step unless the viscosity damps it.
+    leapfrog
+  };
+
   /// Numerical parameters of the solver.
   struct SolverParameters
   {
+    Integrator integrator = Integrator::midpoint;
     double alpha      = 1.0;  ///< Monaghan viscosity, linear term (paper: 1)
     double beta       = 0.1;  ///< Monaghan viscosity, quadratic term (paper: 0.1)
     double av_epsilon = 0.01; ///< eps in mu_ij = h v.r/(r^2 + eps h^2)
@@ -123,6 +141,9 @@ namespace tribo::sph
     std::vector<double>         signal;         ///< c_i + 1.2 alpha c_i + beta max_j mu_ij, m/s
     /// The artificial viscosity's share of de_i/dt, sum_j m_j Pi_ij/2 (v_i - v_j).grad_i W_ij, J/kg/s.
     std::vector<double>         viscous_heating;
+    /// Leapfrog's velocity-gradient pass only: T_i = sum_j m_j (v_i - v_j) (x) grad_i W_ij
+    /// (kg/(m^dim s)), the stress power being de_i/dt = -(sigma_i / rho_i^2) : T_i.
+    std::vector<Tensor<2, dim>> velocity_moment;
     /// Per Solver::imposed entry, the force its constraint supplies, -sum_i m_i dv_i over
     /// the imposed components (before they are zeroed), N (N/m in 2D).
     std::vector<Tensor<1, dim>> imposed_force;
@@ -166,16 +187,18 @@ namespace tribo::sph
     std::vector<ExternalForce<dim>>   external;
     std::vector<Damping>              damping;
 
-    /// One step of the midpoint Runge-Kutta scheme
-    /// y* = y + dt/2 f(y, t), y' = y + dt f(y*, t + dt/2), then exact damping over
-    /// dt and imposed velocities. dt = min(dt_max, @p dt_limit, CFL, acceleration
-    /// steps over all particles), evaluated with f(y, t), or the fixed step
-    /// (SolverParameters::fixed_step). Returns dt.
+    /// One step of SolverParameters::integrator (midpoint: y* = y + dt/2 f(y, t),
+    /// y' = y + dt f(y*, t + dt/2); leapfrog: Integrator::leapfrog), then exact damping
+    /// over dt and imposed velocities. dt = min(dt_max, @p dt_limit, CFL, acceleration
+    /// steps over all particles), evaluated with the rates at the step's start, or the
+    /// fixed step (SolverParameters::fixed_step). Returns dt.
     /// Throws RunError if dt < dt_min (naming the limit and the particles) or if
     /// a rate or the new state holds NaN/Inf or a non-positive density.
     double step(double dt_limit = std::numeric_limits<double>::infinity());
     /// Steps until time reaches @p t_end (the last step is shortened). Returns the
-    /// number of steps.
+    /// number of steps. The leapfrog reuses each step's end forces as the next one's start
+    /// forces (step() evaluates them anew): external forces, imposed velocities and
+    /// damping must not change within the call.
     unsigned int advance_to(double t_end);
 
     /// Evaluates all rates at state @p s and time @p t into @p k. With @p viscosity
@@ -188,8 +211,9 @@ namespace tribo::sph
     double stable_step(const ParticleState<dim> &s, const Rates<dim> &k, std::string &limiter,
                        std::vector<unsigned int> &worst) const;
 
-    /// The rates of the last midpoint evaluation (the ones that advanced the
-    /// state): boundary forces for friction measurements, pressures.
+    /// The rates of the last force evaluation (midpoint: the ones that advanced the
+    /// state; leapfrog: at the step's end): boundary forces for friction
+    /// measurements, pressures.
     const Rates<dim> &last_rates() const { return k2; }
     /// Name of the limit that set the last step ("CFL", "acceleration", "dt_max", "dt_limit", "fixed").
     const std::string &last_limiter() const { return limiter; }
@@ -225,6 +249,25 @@ namespace tribo::sph
     std::string describe_particle(const ParticleState<dim> &s, unsigned int i) const;
 
   private:
+    /// What an evaluation computes: every rate; the velocity gradient's (drho, dS, dx,
+    /// velocity_moment); the forces' (dv, boundary_force, signal, pressure,
+    /// imposed_force, the viscous heating in de and viscous_heating).
+    enum class Pass
+    {
+      all,
+      kinematics,
+      forces
+    };
+    template <Pass pass>
+    void   evaluate(const ParticleState<dim> &s, double t, Rates<dim> &k, bool viscosity = true);
+    double midpoint_step(double dt_limit);
+    double leapfrog_step(double dt_limit);
+    /// The step from rates @p k at the state's start (step()); RunError below dt_min.
+    double step_size(const Rates<dim> &k, double dt_limit);
+    /// RunError naming the particles whose rates in @p k are not finite.
+    void check_rates(const Rates<dim> &k) const;
+    /// Damping, time, imposed velocities (counted) and the finiteness check after a step.
+    void finish_step(double dt);
     /// Sets the imposed velocity components; with @p count, adds the reset's impulse
     /// sum m (v_imposed - v) to each entry's ImposedVelocity::impulse. At a Runge-Kutta
     /// @p stage the entries imposed only between steps are left alone.
@@ -243,6 +286,7 @@ namespace tribo::sph
     std::vector<Tensor<1, dim>> x_at_build;    ///< positions at the last list build, m
     double                      built_cutoff = 0; ///< the list's cut-off c (1 + skin), m
     unsigned long               builds = 0;
+    bool forces_current = false; ///< leapfrog: k2 holds the forces at the current state
     /// Rebuild the neighbour list if a pair within @p cutoff may be missing from it.
     void update_neighbours(const ParticleState<dim> &s, double cutoff);
   };
