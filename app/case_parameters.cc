@@ -60,7 +60,7 @@ namespace tribo::app
     }
 
     /// The upper first body of the shear cell @p p: its own entries, read by coupling,
-    /// and the cell's geometry, load and time step; checked as a whole unless rigid.
+    /// and the cell's geometry, load and time step; checked as a whole.
     coupling::FirstBodyParameters upper_body_parameters(const ParameterFile &f, const CaseParameters &p)
     {
       const auto                   &sc = p.shear;
@@ -76,15 +76,14 @@ namespace tribo::app
       b.pressure_ramp_time = sc.ramp_time;
       if (sc.shear_start == 0)
         b.compaction_damping = 0; // no compaction phase
-      if (b.model != "rigid")
-        try
-          {
-            coupling::check_first_body(b);
-          }
-        catch (const InputError &e)
-          {
-            throw InputError(f.filename() + ": " + e.what());
-          }
+      try
+        {
+          coupling::check_first_body(b);
+        }
+      catch (const InputError &e)
+        {
+          throw InputError(f.filename() + ": " + e.what());
+        }
       return b;
     }
   } // namespace

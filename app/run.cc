@@ -9,10 +9,12 @@
 #include "core/parameter_file.h"
 #include "core/run_control.h"
 #include "core/serialization.h"
+#include "coupling/first_body_models.h"
 
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <chrono>
@@ -26,12 +28,33 @@ namespace tribo::app
 {
   namespace fs = std::filesystem;
 
+  namespace
+  {
+    /// The upper first body's entries a resumed run may change, with their subsection.
+    std::vector<std::string> first_body_entries_that_may_change()
+    {
+      std::vector<std::string> entries;
+      for (const std::string &e : coupling::entries_that_may_change_on_resume())
+        entries.push_back("Shear cell/" + e);
+      return entries;
+    }
+
+    /// "Solver/*, Output/*, Simulation/End time and ..." for the refusal's message.
+    std::string changeable_entries()
+    {
+      std::string text = "Solver/*, Output/*, Simulation/End time";
+      const auto  first_body = first_body_entries_that_may_change();
+      for (std::size_t i = 0; i < first_body.size(); ++i)
+        text += (i + 1 == first_body.size() ? " and " : ", ") + first_body[i];
+      return text;
+    }
+  } // namespace
+
   bool may_change_on_resume(const std::string &entry)
   {
-    // The prediction depth says only how the contact solve's prediction of a particle body
-    // is computed (its real advances are the same), as the Solver entries do.
-    return entry.rfind("Solver/", 0) == 0 || entry.rfind("Output/", 0) == 0 ||
-           entry == "Simulation/End time" || entry == "Shear cell/Upper body prediction depth";
+    const auto first_body = first_body_entries_that_may_change();
+    return entry.rfind("Solver/", 0) == 0 || entry.rfind("Output/", 0) == 0 || entry == "Simulation/End time" ||
+           std::find(first_body.begin(), first_body.end(), entry) != first_body.end();
   }
 
   std::string resume_changes(const std::map<std::string, std::string> &saved,
@@ -52,8 +75,7 @@ namespace tribo::app
         if (!may_change_on_resume(entry))
           throw InputError("--resume " + dir + ": entry '" + entry + "' is '" + value +
                            "' in the case but '" + before + "' in the checkpoint; a resumed run "
-                           "may change only Solver/*, Output/*, Simulation/End time and Shear cell/Upper body "
-                           "prediction depth");
+                           "may change only " + changeable_entries());
         changed += (changed.empty() ? "" : ", ") + entry + " " + before + " -> " + value;
       }
     return (changed.empty() ? "" : "; changed: " + changed) +

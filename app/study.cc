@@ -6,6 +6,7 @@
 #include "core/output.h"
 #include "core/parameter_file.h"
 #include "core/run_control.h"
+#include "coupling/first_body_models.h"
 
 #include <deal.II/base/mpi.h>
 
@@ -135,7 +136,7 @@ namespace tribo::app
       preparation.push_back("Simulation/End time=" + file->get("Shear cell/Shear start"));
       preparation.push_back("Output/Plots=false");
       dealii::ParameterHandler prepared;
-      if (resolved_case(prepared, base, preparation)->get("Shear cell/Upper body model") != "rigid")
+      if (!coupling::is_wall_of_discs(resolved_case(prepared, base, preparation)->get("Shear cell/Upper body model")))
         return {};
       return preparation;
     }

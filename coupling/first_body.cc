@@ -1,4 +1,5 @@
 #include "coupling/first_body.h"
+#include "coupling/first_body_models.h"
 
 #include "core/errors.h"
 #include "core/parameter_file.h"
@@ -6,6 +7,8 @@
 #include <deal.II/base/parameter_handler.h>
 
 #include <cmath>
+#include <iterator>
+#include <stdexcept>
 #include <sstream>
 #include <tuple>
 #include <utility>
@@ -30,17 +33,20 @@ namespace tribo::coupling
 #endif
 
     /// The upper first-body models (the Upper body model entry): name, least number of
-    /// chain nodes, the build option of their module and their factory (null when the
-    /// build left the module out).
+    /// chain nodes, the build option of their module, their factory (null when the build
+    /// left the module out, and for the wall of discs, which the scene builds), and whether
+    /// the model is a wall of discs (is_wall_of_discs()).
     struct FirstBodyModel
     {
       const char *name;
       long        min_chain_nodes;
       const char *build_option;
       std::unique_ptr<FirstBody> (*make)(const FirstBodyParameters &);
+      bool        wall_of_discs = false;
     };
 
     const FirstBodyModel models[] = {
+      {"rigid", 0, "", nullptr, true},
 #ifdef TRIBO_WITH_FEM
       {"fem", 1, "TRIBO_WITH_FEM", make_fem_first_body},
       {"reduced", 1, "TRIBO_WITH_FEM", make_fem_first_body},
@@ -60,21 +66,43 @@ namespace tribo::coupling
 #endif
     };
 
-    const FirstBodyModel &model_of(const FirstBodyParameters &p)
+    /// "rigid, fem, reduced, sph or mlp" (@p last_separator " or ") or
+    /// "rigid|fem|reduced|sph|mlp" (separators "|").
+    std::string model_names(const std::string &separator, const std::string &last_separator)
+    {
+      std::string names;
+      const std::size_t n = std::size(models);
+      for (std::size_t i = 0; i < n; ++i)
+        names += (i == 0 ? "" : i + 1 == n ? last_separator : separator) + std::string(models[i].name);
+      return names;
+    }
+
+    const FirstBodyModel &model_of(const std::string &model)
     {
       for (const FirstBodyModel &m : models)
-        if (p.model == m.name)
+        if (model == m.name)
           return m;
-      throw InputError("unknown upper body model '" + p.model + "': expected rigid, fem, reduced, sph or mlp");
+      throw InputError("unknown upper body model '" + model + "': expected " + model_names(", ", " or "));
     }
+    const FirstBodyModel &model_of(const FirstBodyParameters &p) { return model_of(p.model); }
   } // namespace
+
+  bool is_wall_of_discs(const std::string &model) { return model_of(model).wall_of_discs; }
+
+  const std::vector<std::string> &entries_that_may_change_on_resume()
+  {
+    // The prediction depth says only how the contact solve's prediction of a particle body
+    // is computed (its real advances are the same), as the Solver entries do.
+    static const std::vector<std::string> entries = {"Upper body prediction depth"};
+    return entries;
+  }
 
   void FirstBodyParameters::declare(dealii::ParameterHandler &prm)
   {
     using dealii::Patterns::Double;
     using dealii::Patterns::Integer;
     using dealii::Patterns::Selection;
-    prm.declare_entry("Upper body model", "rigid", Selection("rigid|fem|reduced|sph|mlp"),
+    prm.declare_entry("Upper body model", "rigid", Selection(model_names("|", "|")),
                       "rigid: a rough wall of discs with the mass of the first body (the paper's "
                       "classical model); fem: a plane-strain elastic body of that thickness "
                       "(deal.II), touched through half-disc elements (the paper's hybrid model); reduced: "
@@ -261,6 +289,8 @@ namespace tribo::coupling
   {
     check_first_body(p);
     const FirstBodyModel &m = model_of(p);
+    if (m.wall_of_discs)
+      throw std::logic_error("make_first_body: the " + p.model + " model is a wall of discs, which the scene builds");
     if (!m.make)
       throw InputError(p.section.entry("Upper body model") + " = " + p.model + " needs a module this build left out (" +
                        m.build_option + "=OFF); rebuild with -D" + m.build_option + "=ON");

@@ -23,6 +23,7 @@
 #include "core/errors.h"
 
 #include "coupling/first_body.h"
+#include "coupling/first_body_models.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -326,7 +327,7 @@ namespace tribo::app
                             const std::function<std::pair<unsigned int, double>()> &wall)
       {
         const auto &k = prm.shear;
-        if (k.upper_body.model != "rigid")
+        if (!coupling::is_wall_of_discs(k.upper_body.model))
           {
             upper_body = make_deformable_upper_body(k.upper_body, surface);
             return;

@@ -2,6 +2,8 @@
 // (coupling/elastic_boundary.h): a column of grains between a fixed rigid wall and
 // an elastic block under top pressure.
 #include "coupling/elastic_boundary.h"
+#include "coupling/first_body_models.h"
+#include "core/errors.h"
 #include "dem/moreau_jean.h"
 
 #include <gtest/gtest.h>
@@ -398,4 +400,23 @@ TEST(Coupling, GrainsSlidingUnderAShiftedFaceAreNeverLost)
         }
       EXPECT_NEAR(wall_force, P * prm.length, 0.05 * P * prm.length) << "shift " << spacings;
     }
+}
+
+TEST(Coupling, TheModelTableSaysWhichModelIsAWallOfDiscsAndWhatMayChangeOnResume)
+{
+  // The scene and the study ask the table, not the model's name.
+  EXPECT_TRUE(tribo::coupling::is_wall_of_discs("rigid"));
+  for (const char *model : {"fem", "reduced", "sph", "mlp"})
+    EXPECT_FALSE(tribo::coupling::is_wall_of_discs(model)) << model;
+  try
+    {
+      tribo::coupling::is_wall_of_discs("wood");
+      FAIL() << "an unknown model was accepted";
+    }
+  catch (const tribo::InputError &e)
+    {
+      EXPECT_STREQ(e.what(), "unknown upper body model 'wood': expected rigid, fem, reduced, sph or mlp");
+    }
+  EXPECT_EQ(tribo::coupling::entries_that_may_change_on_resume(),
+            std::vector<std::string>{"Upper body prediction depth"});
 }
