@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numeric>
 #include <sstream>
+#include <type_traits>
 
 namespace tribo::sph
 {
@@ -147,7 +148,13 @@ namespace tribo::sph
     const double         bf_range2 = bf.range() * bf.range();
     const double         alpha = viscosity ? prm.alpha : 0.0, beta = viscosity ? prm.beta : 0.0;
     const double         eps   = prm.av_epsilon;
-    parallel_for(n, [&](unsigned int i) {
+    // One body of one smoothing length (the first bodies, the plate): the pair loop skips
+    // the body test and takes h_ij = h_i (the same values, fewer loads per pair).
+    bool uniform = true;
+    for (unsigned int i = 1; i < n && uniform; ++i)
+      uniform = s.body[i] == s.body[0] && s.h[i] == s.h[0];
+    const auto particle = [&](unsigned int i, auto one_body) {
+      constexpr bool same = decltype(one_body)::value;
       Tensor<1, dim> acc, fb;
       Tensor<2, dim> L, M, T;
       double         drho = 0, de = 0, heating = 0, max_mu = 0;
@@ -156,7 +163,7 @@ namespace tribo::sph
           const unsigned int   j  = search.list[q];
           const Tensor<1, dim> r  = search.separation(s.x[i], s.x[j]);
           const double         r2 = r.norm_square();
-          if (s.body[i] != s.body[j])
+          if (!same && s.body[i] != s.body[j])
             {
               if constexpr (forces)
                 {
@@ -184,10 +191,10 @@ namespace tribo::sph
                 }
               continue;
             }
-          const double hij = 0.5 * (s.h[i] + s.h[j]);
+          const double hij = same ? s.h[i] : 0.5 * (s.h[i] + s.h[j]);
           if (r2 >= 4 * hij * hij)
             continue;
-          const double         inv_hij = s.h[i] == s.h[j] ? inv_h[i] : 1 / hij;
+          const double         inv_hij = same || s.h[i] == s.h[j] ? inv_h[i] : 1 / hij;
           const Tensor<1, dim> g       = CubicSplineKernel<dim>::gradient(r, r2, inv_hij);
           const Tensor<1, dim> dv = s.v[i] - s.v[j];
           const double         mj = s.mass[j];
@@ -248,7 +255,11 @@ namespace tribo::sph
           k.signal[i]          = c[i] * (1 + 1.2 * alpha) + beta * max_mu;
         }
       k.de[i] = de;
-    });
+    };
+    if (uniform)
+      parallel_for(n, [&](unsigned int i) { particle(i, std::true_type()); });
+    else
+      parallel_for(n, [&](unsigned int i) { particle(i, std::false_type()); });
 
     if constexpr (!forces)
       return;
