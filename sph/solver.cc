@@ -129,8 +129,8 @@ namespace tribo::sph
 
     // Per-particle pressure, longitudinal sound speed, sigma/rho^2, volume m/rho and 1/h:
     // loaded in the pair loop rather than recomputed per pair.
-    std::vector<double>                  c(n), volume(n), inv_h(n);
-    std::vector<SymmetricTensor<2, dim>> A(n);
+    std::vector<double>                  c(forces ? n : 0), volume(n), inv_h(n);
+    std::vector<SymmetricTensor<2, dim>> A(forces ? n : 0); // the velocity gradient needs neither
     parallel_for(n, [&](unsigned int i) {
       if constexpr (forces)
         {
