@@ -66,7 +66,6 @@ namespace tribo::app
       const auto                   &sc = p.shear;
       coupling::FirstBodyParameters b  = coupling::FirstBodyParameters::parse(f, "Shear cell");
       b.length             = sc.length;
-      b.thickness          = sc.upper_body_thickness;
       b.density            = sc.density;
       if (b.resolution == 0)
         b.resolution = sc.mean_diameter * (1 - sc.diameter_spread);
@@ -156,14 +155,6 @@ declare_scene_subsections(prm);
     prm.declare_entry("Shear start", "1e-5", Double(),
                       "Time at which the lower wall starts sliding, s (>= 0): compaction before; at or after "
                       "Simulation/End time the run only compacts.");
-    prm.declare_entry("Compaction speed limit", "1", Double(),
-                      "Before Shear start, the upper wall's vertical speed is capped at this value, m/s "
-                      "(>= 0; 0: no cap), so that the compaction stroke under P cannot hit the grains "
-                      "at tens of m/s and tunnel into the layer. Not applied while shearing, nor to a deformable "
-                      "upper body (see Upper body compaction damping).");
-    prm.declare_entry("Upper body thickness", "1.5e-4", Double(),
-                      "Thickness of the first body the upper wall stands for, m (> 0; paper: 1.5e-4): "
-                      "its mass is density * thickness * L.");
     prm.declare_entry("Profile samples", "500", Integer(1),
                       "Profile samples: the shearing phase is cut into this many blocks of consecutive steps, "
                       "each sample the mean over every step of its block (no snapshot that could alias a "
@@ -252,8 +243,6 @@ declare_scene_subsections(prm);
         sc.ramp_time = f.get_checked(S + "Pressure ramp time", is_non_negative, "a time >= 0 in s");
         sc.sliding_velocity = f.get_checked(S + "Sliding velocity", [](double v) { return std::isfinite(v); }, "a velocity in m/s");
         sc.shear_start = f.get_checked(S + "Shear start", is_non_negative, "a time >= 0 in s");
-        sc.compaction_speed = f.get_checked(S + "Compaction speed limit", is_non_negative, "a speed >= 0 in m/s");
-        sc.upper_body_thickness = f.get_checked(S + "Upper body thickness", is_positive, "a positive thickness in m");
         sc.profile_samples = f.get_integer(S + "Profile samples");
         sc.layer_thickness = f.get_checked(S + "Layer thickness", is_non_negative, "a thickness >= 0 in m");
         sc.seed = f.get_integer(S + "Seed");

@@ -40,8 +40,6 @@ namespace tribo::app
     double       ramp_time;            ///< s over which P rises linearly from 0
     double       sliding_velocity;     ///< V of the lower wall along x, m/s
     double       shear_start;          ///< s: compaction before, shearing after
-    double       compaction_speed;     ///< cap on the upper wall's |v_y| before shear_start, m/s (0: none)
-    double       upper_body_thickness; ///< m: upper wall mass = density * thickness * L
     unsigned int profile_samples;      ///< profile samples over the shearing phase
     double       layer_thickness;      ///< profile layer thickness, m (0: d)
     unsigned int seed;
@@ -52,14 +50,11 @@ namespace tribo::app
     /// Shear cell/Initial state as an absolute directory ("" for none): its
     /// sample_final.csv is in @c sample, its final time in CaseParameters::start_time.
     std::string             initial_state;
-    /// The upper first body: rigid (a rough wall, a clump of discs), or deformable and
-    /// touched through half-disc elements (dem/boundary.h): fem (the deal.II body of
-    /// fem/), sph or mlp (particle blocks, coupling/particle_first_body.h). Its entries
-    /// are read by coupling (FirstBodyParameters::parse()); the shear cell's fill the rest
-    /// (Length, Upper body thickness, Density, Pressure, ramp, the Simulation's theta and
-    /// time step; a cell size of 0 becomes d(1-s), and no compaction damping without a
-    /// compaction phase), checked as a whole by coupling::check_first_body(). The bottom
-    /// face y0 is the scene's to place.
+    /// The upper first body, a model of coupling's table (coupling/first_body.h). Its
+    /// entries are read by coupling (FirstBodyParameters::parse()); the shear cell's fill
+    /// the rest (Length, Density, Pressure, ramp, the Simulation's theta and time step; a
+    /// cell size of 0 becomes d(1-s), and no compaction damping without a compaction
+    /// phase), checked as a whole by coupling::check_first_body(). The scene places it.
     coupling::FirstBodyParameters upper_body;
   };
 

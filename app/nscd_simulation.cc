@@ -156,7 +156,7 @@ namespace tribo::app
               " solves frictionless problems only: with Coulomb friction (mu = " +
               std::to_string(p.law.friction) + ") every step uses NLGS (Method = apgs solves friction itself)");
         // What building the case cost: the modules a case does not use are not built (a
-        // rigid wall builds no deal.II, SPH or MLP object).
+        // wall of discs builds no deal.II, SPH or MLP object).
         setup_time   = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
         setup_memory = peak_memory_mb();
         std::ostringstream cost;

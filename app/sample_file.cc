@@ -187,8 +187,8 @@ namespace tribo::app
                      chosen->first, ""};
     if (!fs::is_regular_file(s.path))
       throw InputError("tribo sample " + run_dir + ": no sample next to the snapshot at t = " +
-                       to_text(chosen->first) + " s (" + s.path + " not found: only shear runs with a rigid "
-                       "upper wall write them)");
+                       to_text(chosen->first) + " s (" + s.path + " not found: only shear runs whose upper "
+                       "body is a wall of discs write them)");
     const RunRecord run = read_run_record(run_dir);
     if (run.length <= 0)
       throw InputError("tribo sample " + run_dir + ": cannot read the run's Shear cell/Length from " +

@@ -367,8 +367,8 @@ namespace tribo::app
         }
       if (!all || shared.preparations.size() == list.overrides.size())
         {
-          shared.note = !all ? "no shared compaction: not every case is a shear case with a rigid-wall "
-                               "compaction (0 < Shear start < End time) and no initial state"
+          shared.note = !all ? "no shared compaction: not every case is a shear case with an upper wall of "
+                               "discs, a compaction (0 < Shear start < End time) and no initial state"
                              : "no shared compaction: every case compacts differently";
           shared.preparations.clear();
           std::fill(shared.of_case.begin(), shared.of_case.end(), -1);

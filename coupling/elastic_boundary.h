@@ -2,7 +2,7 @@
 /// @file The deal.II first body (fem::ElasticBody) behind the solver's coupling
 /// interface: its bottom-face nodes are the boundary nodes.
 
-#include "coupling/first_body.h"
+#include "coupling/deformable_body.h"
 #include "fem/elastic_body.h"
 
 namespace tribo::coupling
@@ -10,7 +10,7 @@ namespace tribo::coupling
   /// Adapter: node positions are reference + displacement at the start of the step,
   /// node velocities those at the end of the previous step, the compliance is the
   /// body's condensed M~^-1 on its bottom nodes (m/s per N s/m).
-  class ElasticBoundary : public FirstBody
+  class ElasticBoundary : public DeformableBody
   {
   public:
     /// @p body must outlive the adapter; start_shearing() keeps its damping.
@@ -59,7 +59,7 @@ namespace tribo::coupling
     void   start_shearing() override { body.set_damping(shear_mass_damping, shear_stiffness_damping); }
     std::string write_fields(const std::string &dir, unsigned int index) const override
     {
-      const std::string name = first_body_snapshot_name(index);
+      const std::string name = deformable_body_snapshot_name(index);
       body.write_vtu(dir + "/" + name);
       return name;
     }

@@ -1,5 +1,6 @@
 // The MLP upper first body: a movable-lattice-particle block (mlp/) behind the coupling
 // interface.
+#include "coupling/models.h"
 #include "coupling/particle_first_body.h"
 
 #include "core/errors.h"
@@ -96,7 +97,7 @@ namespace tribo::coupling
             velocity.values.insert(velocity.values.end(), {particles.velocity[i].x(), particles.velocity[i].y()});
             force.values.insert(force.values.end(), {particles.force[i].x(), particles.force[i].y()});
           }
-        const std::string name = first_body_snapshot_name(index);
+        const std::string name = deformable_body_snapshot_name(index);
         atomic_write(dir + "/" + name, point_cloud_vtu(2, points, {velocity, force}));
         return name;
       }
@@ -156,7 +157,7 @@ namespace tribo::coupling
                          std::vector<dem::Vec2> &chain_position) override
       {
         const double dy   = 0.5 * std::sqrt(3.0) * spacing;
-        const long   rows = prm.prediction_depth > 0 ? std::lround(std::ceil(prm.prediction_depth * p_wave_speed(prm) * h / dy)) : 0;
+        const long   rows = prm.particle.prediction_depth > 0 ? std::lround(std::ceil(prm.particle.prediction_depth * p_wave_speed(prm) * h / dy)) : 0;
         if (rows == 0 || rows + 1 >= ny)
           return false;
         if (std::abs(h - step_built) > 1e-12 * step_built)
@@ -192,7 +193,7 @@ namespace tribo::coupling
     private:
       static mlp::InteractionParameters interaction(const FirstBodyParameters &p)
       {
-        const double nu2 = p.poisson_ratio / (1 - p.poisson_ratio); // <= 1/3: check_first_body()
+        const double nu2 = p.poisson_ratio / (1 - p.poisson_ratio); // <= 1/3: check_mlp_body()
         const double c = p.length / chain_nodes(p);
         const auto   m = mlp::hexagonal_model_for(p.youngs_modulus / (1 - p.poisson_ratio * p.poisson_ratio), nu2, c);
         mlp::InteractionParameters ip;
@@ -214,11 +215,11 @@ namespace tribo::coupling
         return lp;
       }
 
-      /// A Verlet step of at most prm.verlet_fraction of the stability limit that divides @p h.
+      /// A Verlet step of at most prm.particle.verlet_fraction of the stability limit that divides @p h.
       void build_integrator(double h)
       {
         const double carried = integrator ? total_dissipation() : dissipation_offset;
-        substeps_per_step     = std::max(1.0, std::ceil(h / (prm.verlet_fraction * 2 / omega_max)));
+        substeps_per_step     = std::max(1.0, std::ceil(h / (prm.particle.verlet_fraction * 2 / omega_max)));
         integrator            = std::make_unique<mlp::LangevinIntegrator>(forces, particles, integrator_parameters(h));
         dissipation_offset = carried;
         step_built         = h;
@@ -244,7 +245,7 @@ namespace tribo::coupling
     };
   } // namespace
 
-  std::unique_ptr<FirstBody> make_mlp_first_body(const FirstBodyParameters &p)
+  std::unique_ptr<DeformableBody> make_mlp_body(const FirstBodyParameters &p)
   {
     return std::make_unique<MlpFirstBody>(p);
   }

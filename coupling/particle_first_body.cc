@@ -1,6 +1,10 @@
 #include "coupling/particle_first_body.h"
+#include "coupling/models.h"
 
 #include "core/errors.h"
+#include "core/parameter_file.h"
+
+#include <deal.II/base/parameter_handler.h>
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -14,6 +18,55 @@
 
 namespace tribo::coupling
 {
+  void ParticleBodyParameters::declare(dealii::ParameterHandler &prm)
+  {
+    using dealii::Patterns::Double;
+    prm.declare_entry("Upper body smoothing length ratio", "1.2", Double(),
+                      "Smoothing length over particle spacing of the sph upper body (in [1, 2]).");
+    prm.declare_entry("Upper body Verlet fraction", "0.05", Double(),
+                      "Velocity-Verlet step of the mlp upper body as a fraction of its stability limit "
+                      "2 / omega_max of the stiffest bond (in (0, 0.5]): smaller is more accurate and "
+                      "slower. On the 120-disc cell at the fem body's step the energy books close to "
+                      "0.03 % at 0.05 and to 0.17 % at 0.2, which is 3.5 times faster (docs/first_bodies.md).");
+    prm.declare_entry("Upper body prediction depth", "3", Double(),
+                      "sph and mlp upper bodies: the trial advances of each contact step (the chain's free "
+                      "motion the contact solve predicts, and the columns of its compliance) run on the "
+                      "bottom rows within this many wave reaches c_p h of the chain, the rows above them "
+                      "within the interaction's reach carried at their start velocities, instead of on the "
+                      "whole body (>= 0; 0: the whole body, also used when the strip would reach the top). "
+                      "The real advance with the solved impulses is always the whole body's, so the books "
+                      "are unchanged; a strip too thin shows as a larger linearisation miss. At 3 the "
+                      "prediction is the whole body's to 1e-5 (unit tests; 1e-12 at every trial of a "
+                      "sheared default-case mlp run) and a paper-size step costs 0.53 (sph) to 0.65 (mlp) "
+                      "times as much (docs/first_bodies.md, \"Trial advances on a strip\"). May change on --resume.");
+  }
+
+  void ParticleBodyParameters::parse(const ParameterFile &f, FirstBodyParameters &p)
+  {
+    const auto entry = [&](const std::string &name) { return p.section.entry(name); };
+    auto      &q     = p.particle;
+    q.smoothing_ratio = f.get_checked(entry("Upper body smoothing length ratio"),
+                                      [](double v) { return v >= 1 && v <= 2; }, "a ratio in [1, 2]");
+    q.verlet_fraction = f.get_checked(entry("Upper body Verlet fraction"), [](double v) { return v > 0 && v <= 0.5; },
+                                      "a fraction of the stability limit in (0, 0.5]");
+    q.prediction_depth = f.get_checked(entry("Upper body prediction depth"), is_non_negative,
+                                       "a depth >= 0 in wave reaches c_p h");
+  }
+
+  std::vector<std::string> ParticleBodyParameters::entries_that_may_change_on_resume()
+  {
+    return {"Upper body prediction depth"};
+  }
+
+  void check_mlp_body(const FirstBodyParameters &p)
+  {
+    if (p.poisson_ratio > 0.25 + 1e-12)
+      throw InputError("entry '" + p.section.entry("Upper body Poisson ratio") + "' = '" + to_text(p.poisson_ratio) +
+                       "': an mlp upper body needs nu <= 0.25 (its plane-strain 2D ratio nu/(1 - nu) must "
+                       "be <= 1/3: return forces can only lower it); use 0.25 or less, or Upper body "
+                       "model = fem or sph");
+  }
+
   void ParticleFirstBody::set_rows(const std::vector<unsigned int> &bottom, const std::vector<unsigned int> &top_row)
   {
     chain = bottom;

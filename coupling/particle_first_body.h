@@ -49,14 +49,14 @@
 /// R_i . (v_b + u_i) / 2, which is the same at theta = 1/2; impulse_extra_power() carries
 /// the difference otherwise. The body's books then close to its integrator's error.
 
-#include "coupling/first_body.h"
+#include "coupling/deformable_body.h"
 
 #include <string>
 #include <vector>
 
 namespace tribo::coupling
 {
-  class ParticleFirstBody : public FirstBody
+  class ParticleFirstBody : public DeformableBody
   {
   public:
     /// Displacement of a free chain particle by the compliance probe of an unloaded body

@@ -1,4 +1,5 @@
 // The SPH upper first body: a solid SPH block (sph/) behind the coupling interface.
+#include "coupling/models.h"
 #include "coupling/particle_first_body.h"
 
 #include "core/errors.h"
@@ -41,7 +42,7 @@ namespace tribo::coupling
         // Cell centres of [0, L) x [y0 - s/2, y0 + (ny - 1/2) s): rows at y0 + j s.
         const auto points = sph::lattice_points<2>(sph::LatticeType::cubic, Tensor<1, 2>({0, p.bottom - 0.5 * spacing}),
                                                    Tensor<1, 2>({p.length, ny * spacing}), spacing);
-        sph::add_particles(solver.state, points, p.density, spacing * spacing, p.smoothing_ratio * spacing, 0, 0);
+        sph::add_particles(solver.state, points, p.density, spacing * spacing, p.particle.smoothing_ratio * spacing, 0, 0);
         std::vector<unsigned int> bottom, top_row;
         for (unsigned int i = 0; i < solver.state.size(); ++i)
           {
@@ -80,7 +81,7 @@ namespace tribo::coupling
       {
         std::ostringstream os;
         os << "sph upper body: " << solver.state.size() << " particles (" << n_nodes() << " x " << ny
-           << ", spacing " << spacing << " m, smoothing length " << prm.smoothing_ratio << " x spacing), E = " << prm.youngs_modulus
+           << ", spacing " << spacing << " m, smoothing length " << prm.particle.smoothing_ratio << " x spacing), E = " << prm.youngs_modulus
            << " Pa, nu = " << prm.poisson_ratio << ", c_p = " << p_wave_speed(prm) << " m/s";
         return os.str();
       }
@@ -107,7 +108,7 @@ namespace tribo::coupling
             pressure.values.push_back(P);
             energy.values.push_back(s.e[i]);
           }
-        const std::string name = first_body_snapshot_name(index);
+        const std::string name = deformable_body_snapshot_name(index);
         atomic_write(dir + "/" + name, point_cloud_vtu(2, points, {velocity, sxx, syy, sxy, pressure, energy}));
         return name;
       }
@@ -156,8 +157,8 @@ namespace tribo::coupling
       bool advance_strip(double h, const std::vector<dem::Vec2> &chain_force,
                          std::vector<dem::Vec2> &chain_position) override
       {
-        const long rows = prm.prediction_depth > 0 ? std::lround(std::ceil(prm.prediction_depth * p_wave_speed(prm) * h / spacing)) : 0;
-        const long held = std::lround(std::ceil(2 * prm.smoothing_ratio));
+        const long rows = prm.particle.prediction_depth > 0 ? std::lround(std::ceil(prm.particle.prediction_depth * p_wave_speed(prm) * h / spacing)) : 0;
+        const long held = std::lround(std::ceil(2 * prm.particle.smoothing_ratio));
         if (rows == 0 || rows + held >= ny)
           return false;
         const auto &full = solver.state;
@@ -239,7 +240,7 @@ namespace tribo::coupling
     };
   } // namespace
 
-  std::unique_ptr<FirstBody> make_sph_first_body(const FirstBodyParameters &p)
+  std::unique_ptr<DeformableBody> make_sph_body(const FirstBodyParameters &p)
   {
     return std::make_unique<SphFirstBody>(p);
   }

@@ -1,29 +1,22 @@
 // The third-body shear cell (Cao, Renouf, Dubois, Berthier 2011, Fig. 3a):
-// a layer of discs, periodic along x, between two rough walls (clumps of discs).
-// The lower wall is fixed until `Shear start`, then slides at V along x (fixed in
-// y and rotation); the upper wall carries the pressure P (force P L per unit
-// depth, ramped), is free in y only, and has the mass of the first body it
-// stands for. Before `Shear start` the layer compacts under P, with the upper
-// wall's speed capped (Compaction speed limit); a Shear start at or after the End
-// time gives a compaction-only run.
+// a layer of discs, periodic along x, between a rough lower wall (a clump of discs) and
+// the upper first body. The lower wall is fixed until `Shear start`, then slides at V
+// along x (fixed in y and rotation); the upper first body carries the pressure P (force
+// P L per unit depth, ramped). Before `Shear start` the layer compacts under P; a Shear
+// start at or after the End time gives a compaction-only run.
 //
-// With `Upper body model = fem | sph | mlp` the upper first body is deformable
-// (coupling/first_body.h): the deal.II plane-strain body of fem/ (Fig. 3b of the
-// paper), or an SPH or MLP particle block; same thickness, density and period, the
-// pressure P on its top face (ramped the same way), held in x on its top face, touched
-// by the grains through half-disc elements on its bottom face (the bottom row of
-// particles for sph and mlp). Its bottom face stands where the rigid wall's disc
-// centres would be, less half a wall disc plus half a half-disc, so that all models
-// start from the same layer.
+// The upper first body is a model of coupling's table (`Upper body model`,
+// coupling/first_body.h), seen here through one interface: the scene gives it the place
+// where the upper wall's discs would stand (a wall of discs takes them; a deformable body
+// puts the bottom of its half-disc elements on their surface, so that all models start
+// from the same layer), its load, and asks for its state, fields and checkpoint.
 #include "app/profiles.h"
 #include "app/sample_file.h"
 #include "app/scene.h"
-#include "app/shear_upper_body.h"
 #include "app/steady_state.h"
 #include "core/errors.h"
 
 #include "coupling/first_body.h"
-#include "coupling/first_body_models.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -82,7 +75,7 @@ namespace tribo::app
         normal_force                 = ramp * k.pressure * k.length;
         sliding                      = t >= k.shear_start;
         s.bodies[lower].velocity.x() = sliding ? k.sliding_velocity : 0.0;
-        upper_body->before_step(s, normal_force, sliding, t < k.shear_start ? k.compaction_speed : 0.0);
+        upper_body->before_step(s, normal_force, sliding);
       }
 
       std::string description() const override { return upper_body->describe(); }
@@ -114,7 +107,7 @@ namespace tribo::app
         for (std::size_t b = 0; b < s.bodies.size(); ++b)
           if (b != lower && b != upper_body->system_body())
             ke_tb += s.bodies[b].kinetic_energy();
-        const UpperState ub = upper_body->state(s, power);
+        const coupling::FirstBodyState ub = upper_body->state(s, power);
         if (sliding && std::isnan(vy_at_shear_start))
           vy_at_shear_start = last_vy;
         last_vy = ub.vy;
@@ -320,20 +313,14 @@ namespace tribo::app
       }
 
     private:
-      /// The upper first body of Shear cell/Upper body model, its surface at @p surface
-      /// (m) when deformable; @p wall makes the rigid one, a clump added to @p s with
-      /// its mean disc diameter.
+      /// The upper first body of Shear cell/Upper body model: a deformable body's surface at
+      /// @p surface (m); @p wall adds the rough wall of discs to @p s (its clump and mean
+      /// disc diameter) for a model that is one.
       void place_upper_body(dem::ParticleSystem &s, double surface,
                             const std::function<std::pair<unsigned int, double>()> &wall)
       {
-        const auto &k = prm.shear;
-        if (!coupling::is_wall_of_discs(k.upper_body.model))
-          {
-            upper_body = make_deformable_upper_body(k.upper_body, surface);
-            return;
-          }
-        const auto [clump, diameter] = wall();
-        upper_body = make_rigid_upper_wall(s, clump, k.density, k.upper_body_thickness, k.length, 0.5 * diameter);
+        static_assert(LayerProfiles::no_body == coupling::FirstBody::no_system_body);
+        upper_body = coupling::make_first_body(prm.shear.upper_body, {s, surface, wall});
       }
 
       double draw_diameter()
@@ -448,7 +435,7 @@ namespace tribo::app
               s.bodies[b].spin         = d.spin;
             }
         // A deformable body's surface where the upper wall's was, or just clear of the
-        // grains; the rigid wall from the sample's rows, or generated above the grains.
+        // grains; a wall of discs from the sample's rows, or generated above the grains.
         double surface = top + 0.01 * mean_diameter_of(k.sample);
         if (upper_given)
           {
@@ -517,7 +504,7 @@ namespace tribo::app
         return rows > 0 ? sum / rows : vy_at_shear_start;
       }
       double                         lower_wall_diameter = 0, mean_grain_diameter = 0;
-      std::unique_ptr<UpperBody>     upper_body; ///< rigid wall or deformable body
+      std::unique_ptr<coupling::FirstBody> upper_body;
       std::unique_ptr<LayerProfiles> profiles;
       SteadyState                    steady;
       std::string                    averaging; ///< the log line of averaging_note()

@@ -193,7 +193,7 @@ class BadInput(unittest.TestCase):
                           "4043 interior unknowns less 2", p.stderr)
             self.assertFalse(os.path.exists(out))
 
-    def test_a_mesh_too_fine_is_refused(self):
+    def test_a_mesh_too_fine_is_refused_before_writing(self):
         with tempfile.TemporaryDirectory() as tmp:
             case = os.path.join(tmp, "case.prm")
             with open(case, "w") as f:
@@ -205,6 +205,7 @@ class BadInput(unittest.TestCase):
             self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
             self.assertIn("'Shear cell/Upper body cell size' = '1e-09'", p.stderr)
             self.assertIn("at most 4e6 cells", p.stderr)
+            self.assertFalse(os.path.exists(os.path.join(tmp, "out")), "refused at parse, before writing")
 
 
 if __name__ == "__main__":

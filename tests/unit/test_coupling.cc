@@ -2,6 +2,7 @@
 // (coupling/elastic_boundary.h): a column of grains between a fixed rigid wall and
 // an elastic block under top pressure.
 #include "coupling/elastic_boundary.h"
+#include "coupling/first_body.h"
 #include "coupling/first_body_models.h"
 #include "core/errors.h"
 #include "dem/moreau_jean.h"
@@ -419,4 +420,60 @@ TEST(Coupling, TheModelTableSaysWhichModelIsAWallOfDiscsAndWhatMayChangeOnResume
     }
   EXPECT_EQ(tribo::coupling::entries_that_may_change_on_resume(),
             std::vector<std::string>{"Upper body prediction depth"});
+}
+
+TEST(Coupling, EveryModelIsPlacedThroughTheOneInterface)
+{
+  // The scene asks the table for its upper body and gives both kinds the same place: the
+  // wall of discs takes the clump the scene adds, the deformable body puts its half-discs'
+  // bottom on the surface.
+  coupling::FirstBodyParameters p;
+  p.length = L;
+  p.thickness = 1.5e-4;
+  p.density = rho;
+  p.youngs_modulus = 1e11;
+  p.poisson_ratio = 0.3;
+  p.resolution = l;
+  p.time_step = 1e-9;
+  p.pressure = P;
+  p.rigid.compaction_speed_limit = 0.5;
+  dem::ParticleSystem s;
+  s.period = L;
+  int walls_added = 0;
+  const auto add_wall = [&]() {
+    ++walls_added;
+    return std::make_pair(s.add_clump({{0.25 * L, 3 * l}, {0.75 * L, 3 * l}}, {0.5 * l, 0.3 * l}, rho), 0.8 * l);
+  };
+  coupling::check_first_body(p);
+  const auto wall = coupling::make_first_body(p, {s, 2 * l, add_wall});
+  ASSERT_EQ(walls_added, 1);
+  const unsigned int clump = wall->system_body();
+  ASSERT_LT(clump, s.bodies.size());
+  EXPECT_DOUBLE_EQ(s.bodies[clump].mass, rho * 1.5e-4 * L); // the first body's, not the discs'
+  EXPECT_DOUBLE_EQ(wall->y_to_surface(), 0.4 * l);
+  EXPECT_DOUBLE_EQ(wall->half_disc_diameter(), 0);
+  s.bodies[clump].velocity = {0, -3};
+  wall->before_step(s, 2.5, false);
+  EXPECT_DOUBLE_EQ(s.bodies[clump].load[1], -2.5);
+  EXPECT_DOUBLE_EQ(s.bodies[clump].velocity.y(), -0.5); // capped while compacting
+  s.bodies[clump].velocity = {0, -3};
+  wall->before_step(s, 2.5, true);
+  EXPECT_DOUBLE_EQ(s.bodies[clump].velocity.y(), -3); // free once sliding
+  EXPECT_FALSE(wall->in_energy_balance());
+
+  p.model = "fem";
+  p.thickness = 8 * l;
+  coupling::check_first_body(p);
+  const auto body = coupling::make_first_body(p, {s, 2 * l, add_wall});
+  EXPECT_EQ(walls_added, 1);
+  EXPECT_EQ(body->system_body(), coupling::FirstBody::no_system_body);
+  EXPECT_DOUBLE_EQ(body->half_disc_diameter(), l); // one per cell edge
+  const auto state = body->state(s, {});
+  EXPECT_NEAR(state.surface, 2 * l, 1e-12 * l);
+  EXPECT_NEAR(state.y, 2.5 * l, 1e-12 * l);
+  EXPECT_TRUE(body->in_energy_balance());
+
+  p.fem.modes = 5000;
+  p.model = "reduced";
+  EXPECT_THROW(coupling::check_first_body(p), InputError);
 }

@@ -86,7 +86,7 @@ namespace
     for (int i = 0; i < 8; ++i)
       sys.add_disc({(i + 0.5) * s, y_grain}, 0.5 * s, rho);
 
-    auto body = coupling::make_first_body(column_body(model, h, y_grain + s));
+    auto body = coupling::make_deformable_body(column_body(model, h, y_grain + s));
 
     dem::SolverParameters nlgs;
     nlgs.method    = dem::SolverParameters::Method::nlgs;
@@ -167,12 +167,12 @@ namespace
   };
 
   /// The column's body at rest, its top just loaded by P (no ramp, no damping), for steps @p h.
-  std::unique_ptr<coupling::FirstBody> body_at_rest(const std::string &model, double h)
+  std::unique_ptr<coupling::DeformableBody> body_at_rest(const std::string &model, double h)
   {
     auto p = column_body(model, h, 0);
     p.pressure_ramp_time = 0;
     p.compaction_damping = 0;
-    return coupling::make_first_body(p);
+    return coupling::make_deformable_body(p);
   }
 
   /// A grain pushing chain particle 3 up and sideways with P s h, its neighbour less.
@@ -252,7 +252,7 @@ namespace
     std::printf("\n");
     return misses;
   }
-  /// A particle body's trial advances on a strip of its bottom rows (FirstBodyParameters::
+  /// A particle body's trial advances on a strip of its bottom rows (ParticleBodyParameters::
   /// prediction_depth) against the whole body's: a body 40 s thick at c_p h / s = 4, its top
   /// loaded by P at t = 0 without damping; the compliance at rest, then the free chain
   /// velocities each step while the load's wave crosses the body, reflects at the chain and
@@ -272,9 +272,9 @@ namespace
     prm.thickness = 40 * s;
     prm.pressure_ramp_time = 0;
     prm.compaction_damping = 0;
-    auto whole = coupling::make_first_body(prm);
-    prm.prediction_depth = depth;
-    auto strip = coupling::make_first_body(prm);
+    auto whole = coupling::make_deformable_body(prm);
+    prm.particle.prediction_depth = depth;
+    auto strip = coupling::make_deformable_body(prm);
     const unsigned int n = whole->n_nodes();
     double g_miss = 0, v_run = 0, dv_run = 0, d_run = 0, dd_run = 0;
     std::vector<dem::Vec2> start(n), impulses(n);
