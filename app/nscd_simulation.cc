@@ -110,11 +110,10 @@ namespace tribo::app
     class NscdSimulation : public Simulation
     {
     public:
-      NscdSimulation(const CaseParameters &p, Log &log)
-        : prm(p)
+      NscdSimulation(const CaseParameters &p, std::unique_ptr<Scene> built, Log &log)
+        : prm(p), scene(std::move(built))
       {
         const auto wall_start = std::chrono::steady_clock::now();
-        scene = make_scene(p);
         scene->build(system);
         h                     = scene->time_step(system);
         const double distance = p.law.detection_distance > 0 ? p.law.detection_distance : 0.1 * system.min_radius();
@@ -126,7 +125,7 @@ namespace tribo::app
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
         // A run that goes on from an initial state starts at its step (a whole number of
         // steps, checked with the parameters).
-        start = std::lround(p.start_time / h);
+        start = std::lround(scene->start_time() / h);
         step  = start;
 
         std::ostringstream os;
@@ -139,7 +138,7 @@ namespace tribo::app
         if (start > 0)
           {
             std::ostringstream state;
-            state << "starting from the state of " << p.shear.initial_state << " at t = " << start * h
+            state << "starting from " << scene->start_state() << " at t = " << start * h
                   << " s (step " << start << "; its sample_final.csv, without contact impulses)";
             log(state.str());
           }
@@ -333,8 +332,8 @@ namespace tribo::app
         out.scalars["time_step"] = h;
         out.tables               = scene->tables();
         out.final_sample         = scene->sample(system);
-        if (prm.plots && prm.scene == "shear")
-          out.plot_script = "plot_run.py";
+        if (prm.plots)
+          out.plot_script = scene->plot_script();
 
         std::ostringstream os;
         os << steps_run << " steps in " << end.wall_time << " s, " << per_step(record.total_iterations)
@@ -396,8 +395,8 @@ namespace tribo::app
     };
   } // namespace
 
-  std::unique_ptr<Simulation> make_nscd_simulation(const CaseParameters &p, Log &log)
+  std::unique_ptr<Simulation> make_nscd_simulation(const CaseParameters &p, std::unique_ptr<Scene> scene, Log &log)
   {
-    return std::make_unique<NscdSimulation>(p, log);
+    return std::make_unique<NscdSimulation>(p, std::move(scene), log);
   }
 } // namespace tribo::app

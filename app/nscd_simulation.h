@@ -4,12 +4,14 @@
 
 #include "app/case_parameters.h"
 #include "app/driver.h"
+#include "app/scene.h"
 
 #include <memory>
 
 namespace tribo::app
 {
-  /// The NSCD simulation of the case @p p (Simulation/Scene collision or shear): builds the
-  /// scene, its bodies and the integrator, and logs what was built and what it cost.
-  std::unique_ptr<Simulation> make_nscd_simulation(const CaseParameters &p, Log &log);
+  /// The NSCD simulation of @p scene in the case @p p (its Simulation, Contact law, Solver
+  /// and Output): builds the scene's bodies and the integrator, and logs what was built
+  /// and what it cost.
+  std::unique_ptr<Simulation> make_nscd_simulation(const CaseParameters &p, std::unique_ptr<Scene> scene, Log &log);
 } // namespace tribo::app

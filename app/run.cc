@@ -180,19 +180,16 @@ namespace tribo::app
     for (const auto &s : o.overrides)
       file.set(s);
     const CaseParameters p = read_case_parameters(file);
-    // The sample file by its absolute path in parameters.prm: a resumed run, or one
-    // started from that file elsewhere, finds it.
-    if (!p.shear.sample_file.empty())
-      file.set("Shear cell/Sample file=" + p.shear.sample_file);
-    if (!p.shear.initial_state.empty())
-      file.set("Shear cell/Initial state=" + p.shear.initial_state);
-    // The scene's own entries are checked before anything is written.
+    // The scene's own entries are checked before anything is written, and its paths made
+    // absolute in parameters.prm: a resumed run, or one started from it elsewhere, finds them.
     const SceneEntry &scene = scene_named(p.scene);
     if (!scene.hooks.make)
       throw InputError(o.case_file + ": Simulation/Scene = " + p.scene + " is not in this build (it needs " +
                        scene.build_option + "=ON)");
     if (scene.hooks.check)
       scene.hooks.check(file);
+    if (scene.hooks.resolve)
+      scene.hooks.resolve(file);
     if (o.check_only)
       {
         if (!o.quiet)

@@ -34,6 +34,11 @@ namespace tribo::app
     virtual std::string description() const { return ""; }
     /// The time step to use (the case's, unless the scene derives it).
     virtual double time_step(const dem::ParticleSystem &) const { return prm.time_step; }
+    /// The time the run starts at, s: 0 unless the scene goes on from a state (a whole
+    /// number of time steps; the steps before are not run).
+    virtual double start_time() const { return 0; }
+    /// Where a run with start_time() > 0 starts from, for the log.
+    virtual std::string start_state() const { return ""; }
     /// Adjust loads before step @p step (e.g. a pressure ramp).
     virtual void before_step(dem::ParticleSystem &, unsigned long /*step*/) {}
     /// Measure after every step (the scene's running sums and samples) and add the
@@ -48,6 +53,8 @@ namespace tribo::app
     virtual std::string averaging_note() const { return ""; }
     /// Extra tables, written as NAME.csv and as the HDF5 group NAME (after summarize()).
     virtual std::map<std::string, TimeSeries> tables() const { return {}; }
+    /// The script in scripts/ that plots a run of the scene (with Output/Plots), "" for none.
+    virtual std::string plot_script() const { return ""; }
     /// The state as a sample file (app/sample_file.h), written with every snapshot as
     /// fields/sample_NNNNN.csv and at the end as sample_final.csv; "" when the scene has
     /// none.
@@ -61,7 +68,4 @@ namespace tribo::app
     explicit Scene(const CaseParameters &p) : prm(p) {}
     CaseParameters prm;
   };
-
-  /// The scene named by Simulation/Scene.
-  std::unique_ptr<Scene> make_scene(const CaseParameters &p);
 } // namespace tribo::app

@@ -1,8 +1,6 @@
 #include "app/scenes.h"
 
-#include "app/case_parameters.h"
-#include "app/nscd_simulation.h"
-#include "app/particle_scenes.h"
+#include "app/scene_hooks.h"
 #include "core/errors.h"
 
 #include <algorithm>
@@ -11,11 +9,6 @@ namespace tribo::app
 {
   namespace
   {
-    std::unique_ptr<Simulation> make_nscd(const ParameterFile &, const CaseParameters &p, Log &log)
-    {
-      return make_nscd_simulation(p, log);
-    }
-
     /// Gives the row of scene @p name (a module's scene, in this build) its @p hooks.
     void attach(std::vector<SceneEntry> &table, const std::string &name, const SceneHooks &hooks)
     {
@@ -25,15 +18,15 @@ namespace tribo::app
     }
 
     /// The rows of every scene; those of the particle modules get their hooks only when
-    /// built (app/particle_scenes.h).
+    /// built (app/scene_hooks.h).
     std::vector<SceneEntry> make_table()
     {
       std::vector<SceneEntry> table = {
-        {"collision", "two discs, Cao et al. 2011 Fig. 8", "", {{}, nullptr, make_nscd}},
+        {"collision", "two discs, Cao et al. 2011 Fig. 8", "", collision_hooks()},
         {"shear",
          "the third-body shear cell of Cao et al. 2011: a periodic layer of discs compacted, then sheared, "
          "between two rough walls",
-         "", {{}, nullptr, make_nscd}},
+         "", shear_hooks()},
         {"sph_slider", "the SPH slider on a substrate of Maveyraud et al. 1999, subsection SPH slider",
          "TRIBO_WITH_SPH", {}},
         {"sph_plate", "the SPH cantilever-plate check, subsection SPH plate", "TRIBO_WITH_SPH", {}},

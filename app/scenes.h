@@ -30,10 +30,14 @@ namespace tribo::app
     /// once); empty: none beyond the NSCD subsections.
     std::vector<void (*)(dealii::ParameterHandler &)> declare;
     /// Reads and checks the scene's own entries without building it (InputError naming
-    /// the entry), before anything is written; nullptr: read_case_parameters() did.
+    /// the entry), before anything is written; nullptr: it has none.
     void (*check)(const ParameterFile &) = nullptr;
     /// Builds the scene (what it built goes to the log); nullptr: not in this build.
     std::unique_ptr<Simulation> (*make)(const ParameterFile &, const CaseParameters &, Log &) = nullptr;
+    /// Rewrites the entries whose meaning depends on where the case file is (a relative
+    /// path, as an absolute one), so that parameters.prm means the same from any
+    /// directory (a resumed run, a run started from it elsewhere); nullptr: none.
+    void (*resolve)(ParameterFile &) = nullptr;
   };
 
   struct SceneEntry

@@ -7,7 +7,7 @@
 // Usage: bench_nlgs [CASE.prm] [compaction steps] [timed steps] [--set "Section/Entry=value"]...
 // (bench/nlgs_scaling.sh runs it on 1k to 64k discs.)
 #include "app/case_parameters.h"
-#include "app/scene.h"
+#include "app/scene_hooks.h"
 #include "core/parameter_file.h"
 #include "dem/moreau_jean.h"
 
@@ -61,7 +61,7 @@ int main(int argc, char **argv)
     file.set(o);
   const app::CaseParameters p = app::read_case_parameters(file);
 
-  auto                scene = app::make_scene(p);
+  auto                scene = app::make_shear_scene(file, p);
   dem::ParticleSystem system;
   scene->build(system);
   const double    h = scene->time_step(system);

@@ -4,7 +4,7 @@
 /// "MLP compression".
 /// 2D, per unit depth: masses kg/m, forces N/m, pressures Pa, energies J/m.
 
-#include "app/particle_scenes.h"
+#include "app/scene_hooks.h"
 #include "app/scenes/mlp_family.h"
 #include "app/steady_state.h"
 #include "mlp/analysis.h"

@@ -1,6 +1,6 @@
 #include "app/scenes/mlp_family.h"
 
-#include "app/particle_scenes.h"
+#include "app/scene_hooks.h"
 #include "core/errors.h"
 #include "core/point_cloud.h"
 #include "core/run_control.h"

@@ -3,7 +3,7 @@
 /// (app/scenes/mlp_family.h), subsections "MLP" and "MLP ordering".
 /// 2D, per unit depth: masses kg/m, forces N/m, pressures Pa, energies J/m.
 
-#include "app/particle_scenes.h"
+#include "app/scene_hooks.h"
 #include "app/scenes/mlp_family.h"
 #include "mlp/analysis.h"
 #include "mlp/particles.h"

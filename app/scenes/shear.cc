@@ -10,9 +10,11 @@
 // where the upper wall's discs would stand (a wall of discs takes them; a deformable body
 // puts the bottom of its half-disc elements on their surface, so that all models start
 // from the same layer), its load, and asks for its state, fields and checkpoint.
+#include "app/nscd_simulation.h"
 #include "app/profiles.h"
 #include "app/sample_file.h"
 #include "app/scene.h"
+#include "app/scene_hooks.h"
 #include "app/steady_state.h"
 #include "core/errors.h"
 
@@ -26,6 +28,7 @@
 #include <functional>
 #include <sstream>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <numeric>
 #include <tuple>
@@ -35,19 +38,224 @@ namespace tribo::app
 {
   namespace
   {
+    using dealii::Patterns::Anything;
+    using dealii::Patterns::Double;
+    using dealii::Patterns::Integer;
+
+    /// The third-body shear cell of Cao et al. 2011: a periodic layer of discs
+    /// between a rough lower wall driven at V and a rough upper wall under P.
+    struct ShearCellParameters
+    {
+      unsigned int n_discs;
+      double       mean_diameter;        ///< d, m
+      double       diameter_spread;      ///< relative half-width: d in [d(1-s), d(1+s)]
+      double       density;              ///< kg/m^3
+      double       length;               ///< period L along x, m
+      unsigned int wall_discs;           ///< discs per wall (0: L/d)
+      double       wall_disc_diameter;   ///< m; 0: drawn like the grains' diameters
+      double       pressure;             ///< P, Pa; force P L (N/m) on the upper wall
+      double       ramp_time;            ///< s over which P rises linearly from 0
+      double       sliding_velocity;     ///< V of the lower wall along x, m/s
+      double       shear_start;          ///< s: compaction before, shearing after
+      unsigned int profile_samples;      ///< profile samples over the shearing phase
+      double       layer_thickness;      ///< profile layer thickness, m (0: d)
+      unsigned int seed;
+      /// Shear cell/Sample file as an absolute path ("" for generated grains), and its
+      /// discs (app/sample_file.h), read and checked with the parameters.
+      std::string             sample_file;
+      std::vector<SampleDisc> sample;
+      /// Shear cell/Initial state as an absolute directory ("" for none): its
+      /// sample_final.csv is in @c sample, its final time in start_time.
+      std::string             initial_state;
+      /// s: the time the run starts at, 0 unless an initial state gives a later one (a whole
+      /// number of time steps; the steps before are not run).
+      double                  start_time = 0;
+      /// The upper first body, a model of coupling's table (coupling/first_body.h). Its
+      /// entries are read by coupling (FirstBodyParameters::parse()); the shear cell's fill
+      /// the rest (Length, Density, Pressure, ramp, the Simulation's theta and time step; a
+      /// cell size of 0 becomes d(1-s), and no compaction damping without a compaction
+      /// phase), checked as a whole by coupling::check_first_body(). The scene places it.
+      coupling::FirstBodyParameters upper_body;
+
+      /// Declare subsection Shear cell.
+      static void declare(dealii::ParameterHandler &prm)
+      {
+        prm.enter_subsection("Shear cell");
+        prm.declare_entry("Number of discs", "3820", Integer(1), "Third-body discs, >= 1 (paper: 3820).");
+        prm.declare_entry("Mean diameter", "1.2e-6", Double(), "Mean disc diameter d, m (> 0; paper: 1.2e-6).");
+        prm.declare_entry("Diameter spread", "0.2", Double(0, 0.99),
+                          "Relative half-width s of the uniform diameter distribution [d(1-s), d(1+s)] (paper: 0.2).");
+        prm.declare_entry("Density", "7800", Double(), "Density of discs, walls and first bodies, kg/m^3 (> 0).");
+        prm.declare_entry("Length", "1e-4", Double(), "Period L along x, m (> 0; paper: 1e-4).");
+        prm.declare_entry("Wall discs", "72", Integer(0),
+                          "Discs in each rough wall, spread evenly along L (paper: 72); 0 gives about L/d "
+                          "(d: Wall disc diameter if given, else the mean diameter).");
+        prm.declare_entry("Wall disc diameter", "0", Double(0),
+                          "Diameter of every wall disc, m (>= 0); 0: drawn from the grains' distribution "
+                          "(the paper's walls).");
+        prm.declare_entry("Pressure", "1e8", Double(), "Pressure P on the upper wall, Pa (> 0); force P L per unit depth.");
+        prm.declare_entry("Pressure ramp time", "2e-6", Double(), "Time over which P rises linearly from 0, s (>= 0).");
+        prm.declare_entry("Sliding velocity", "5", Double(), "Velocity V of the lower wall along x once shearing starts, m/s.");
+        prm.declare_entry("Shear start", "1e-5", Double(),
+                          "Time at which the lower wall starts sliding, s (>= 0): compaction before; at or after "
+                          "Simulation/End time the run only compacts.");
+        prm.declare_entry("Profile samples", "500", Integer(1),
+                          "Profile samples: the shearing phase is cut into this many blocks of consecutive steps, "
+                          "each sample the mean over every step of its block (no snapshot that could alias a "
+                          "periodic motion); profiles.csv averages the samples of the steady state (paper: 500 "
+                          "snapshots).");
+        prm.declare_entry("Layer thickness", "0", Double(),
+                          "Thickness of the profile layers, m (>= 0); 0: one mean diameter.");
+        prm.declare_entry("Seed", "1", Integer(0), "Seed of the disc sizes.");
+        prm.declare_entry("Sample file", "", Anything(),
+                          "A CSV file of discs to start from instead of generated grains: header "
+                          "'x,y,r,body' (optionally ',vx,vy,spin'), SI units, body = grain, lower_wall or "
+                          "upper_wall (each wall one rigid body; without wall rows both walls are "
+                          "generated). A relative path is relative to the case file. Number of discs, "
+                          "Mean diameter, Diameter spread and Seed then do not act on the grains; "
+                          "with a deformable Upper body model, the body's surface stands where the upper wall's "
+                          "would (docs/outputs.md, 'Sample files').");
+        prm.declare_entry("Initial state", "", Anything(),
+                          "The directory of a completed shear run (e.g. a compaction-only run, "
+                          "Shear start >= End time) to go on from: the case starts at that run's final time "
+                          "t0 from its sample_final.csv (grains, walls, their velocities; not the contact "
+                          "impulses), with this case's parameters from t0 on; the steps before t0 are not "
+                          "run. t0 must be a whole number of time steps and before End time; the Length "
+                          "must be the run's. A relative path is relative to the case file. Not with "
+                          "Sample file. A deformable Upper body model takes the upper wall's place, unloaded, and "
+                          "takes the load over Pressure ramp time from t0 (docs/outputs.md, 'Initial states').");
+        coupling::FirstBodyParameters::declare(prm);
+        prm.leave_subsection();
+      }
+
+      /// Read and check subsection Shear cell of @p f in the case @p p (its time step, End
+      /// time and theta); InputError naming the entry.
+      static ShearCellParameters parse(const ParameterFile &f, const CaseParameters &p);
+    };
+
+    /// Shear cell/Initial state = @p given: the final sample and time of a completed
+    /// shear run, checked against the case @p p (its time step and End time) and the
+    /// cell @p sc (its Length) into sc.initial_state, sc.sample and sc.start_time.
+    void read_initial_state(const ParameterFile &f, const std::string &given, const CaseParameters &p,
+                            ShearCellParameters &sc)
+    {
+      namespace fs         = std::filesystem;
+      const std::string E  = "Shear cell/Initial state";
+      if (!sc.sample_file.empty())
+        f.fail(E, "no initial state together with a Shear cell/Sample file (each gives the discs)");
+      const fs::path dir = fs::absolute(fs::path(given).is_absolute()
+                                          ? fs::path(given)
+                                          : fs::path(f.filename()).parent_path() / given)
+                             .lexically_normal();
+      sc.initial_state = dir.string();
+      const RunRecord run = read_run_record(dir.string());
+      if (run.status != "complete" || run.scene != "shear" || !fs::is_regular_file(dir / "sample_final.csv"))
+        f.fail(E, "the directory of a completed shear run (" + dir.string() +
+                    (run.status.empty() ? " has no readable summary.json"
+                                        : " has status '" + run.status + "', scene '" + run.scene + "'" +
+                                            (fs::is_regular_file(dir / "sample_final.csv") ? ""
+                                                                                           : ", no sample_final.csv")) +
+                    ")");
+      if (std::abs(run.length - sc.length) > 1e-12 * sc.length)
+        f.fail(E, "a run of this case's Shear cell/Length = " + to_text(sc.length) + " m (" + dir.string() +
+                    " has " + to_text(run.length) + " m)");
+      const double steps = run.simulated_time / p.time_step;
+      if (std::abs(steps - std::round(steps)) > 1e-6 * std::max(1.0, steps))
+        f.fail(E, "a state at a whole number of time steps (" + dir.string() + " ends at t0 = " +
+                    to_text(run.simulated_time) + " s, " + to_text(steps) + " steps of Simulation/Time step = " +
+                    to_text(p.time_step) + " s)");
+      if (p.end_time <= run.simulated_time)
+        f.fail(E, "a state before Simulation/End time = " + to_text(p.end_time) + " s (" + dir.string() +
+                    " ends at t0 = " + to_text(run.simulated_time) + " s)");
+      sc.start_time = std::round(steps) * p.time_step;
+      sc.sample    = read_sample((dir / "sample_final.csv").string(), sc.length);
+    }
+
+    /// The upper first body of the shear cell @p sc: its own entries, read by coupling,
+    /// and the cell's geometry, load and the case's time step; checked as a whole.
+    coupling::FirstBodyParameters upper_body_parameters(const ParameterFile &f, const CaseParameters &p,
+                                                        const ShearCellParameters &sc)
+    {
+      coupling::FirstBodyParameters b  = coupling::FirstBodyParameters::parse(f, "Shear cell");
+      b.length             = sc.length;
+      b.density            = sc.density;
+      if (b.resolution == 0)
+        b.resolution = sc.mean_diameter * (1 - sc.diameter_spread);
+      b.theta              = p.theta;
+      b.time_step          = p.time_step;
+      b.pressure           = sc.pressure;
+      b.pressure_ramp_time = sc.ramp_time;
+      if (sc.shear_start == 0)
+        b.compaction_damping = 0; // no compaction phase
+      try
+        {
+          coupling::check_first_body(b);
+        }
+      catch (const InputError &e)
+        {
+          throw InputError(f.filename() + ": " + e.what());
+        }
+      return b;
+    }
+
+    ShearCellParameters ShearCellParameters::parse(const ParameterFile &f, const CaseParameters &p)
+    {
+      ShearCellParameters sc;
+        const std::string S = "Shear cell/";
+      sc.n_discs         = f.get_integer(S + "Number of discs");
+      sc.mean_diameter   = f.get_checked(S + "Mean diameter", is_positive, "a positive diameter in m");
+      sc.diameter_spread = f.get_double(S + "Diameter spread");
+      sc.density         = f.get_checked(S + "Density", is_positive, "a positive density in kg/m^3");
+      sc.length          = f.get_checked(S + "Length", is_positive, "a positive length in m");
+      const double d_max = sc.mean_diameter * (1 + sc.diameter_spread);
+      if (sc.length < 8 * d_max)
+        f.fail(S + "Length", "a length of at least 8 largest diameters (" + to_text(8 * d_max) + " m)");
+      sc.wall_discs         = f.get_integer(S + "Wall discs");
+      sc.wall_disc_diameter = f.get_double(S + "Wall disc diameter");
+      if (sc.wall_disc_diameter > sc.length / 8)
+        f.fail(S + "Wall disc diameter", "a diameter of at most L/8 = " + to_text(sc.length / 8) +
+                                           " m (a wall of at least 8 discs), or 0");
+      const double d_wall   = sc.wall_disc_diameter > 0 ? sc.wall_disc_diameter
+                                                        : sc.mean_diameter * (1 - sc.diameter_spread);
+      if (sc.wall_discs > 0 && sc.wall_discs * d_wall > sc.length * (1 + 1e-12))
+        f.fail(S + "Wall discs", "at most " + std::to_string(int(sc.length / d_wall * (1 + 1e-12))) +
+                                   " discs, so that they fit along the length without overlapping");
+      sc.pressure  = f.get_checked(S + "Pressure", is_positive, "a positive pressure in Pa");
+      sc.ramp_time = f.get_checked(S + "Pressure ramp time", is_non_negative, "a time >= 0 in s");
+      sc.sliding_velocity = f.get_checked(S + "Sliding velocity", [](double v) { return std::isfinite(v); }, "a velocity in m/s");
+      sc.shear_start = f.get_checked(S + "Shear start", is_non_negative, "a time >= 0 in s");
+      sc.profile_samples = f.get_integer(S + "Profile samples");
+      sc.layer_thickness = f.get_checked(S + "Layer thickness", is_non_negative, "a thickness >= 0 in m");
+      sc.seed = f.get_integer(S + "Seed");
+      if (const std::string sample = f.get(S + "Sample file"); !sample.empty())
+        {
+          const std::filesystem::path given(sample);
+          sc.sample_file = std::filesystem::absolute(
+            given.is_absolute() ? given : std::filesystem::path(f.filename()).parent_path() / given)
+                             .lexically_normal()
+                             .string();
+          sc.sample = read_sample(sc.sample_file, sc.length);
+        }
+      if (const std::string state = f.get(S + "Initial state"); !state.empty())
+        read_initial_state(f, state, p, sc);
+      sc.upper_body = upper_body_parameters(f, p, sc);
+      return sc;
+    }
+
     class ShearCellScene : public Scene
     {
     public:
-      explicit ShearCellScene(const CaseParameters &p)
+      ShearCellScene(const CaseParameters &p, const ShearCellParameters &k)
         : Scene(p)
-        , rng(p.shear.seed)
+        , cell(k)
+        , rng(k.seed)
       {}
 
       void build(dem::ParticleSystem &s) override
       {
-        const auto &k = prm.shear;
+        const auto &k = cell;
         s.period      = k.length;
-        steps_done    = std::lround(prm.start_time / prm.time_step);
+        steps_done    = std::lround(cell.start_time / prm.time_step);
         if (!k.sample.empty())
           build_from_sample(s);
         else
@@ -68,9 +276,9 @@ namespace tribo::app
 
       void before_step(dem::ParticleSystem &s, unsigned long step) override
       {
-        const auto  &k    = prm.shear;
+        const auto  &k    = cell;
         const double t    = step * prm.time_step;
-        const double t_load = upper_body->load_time(t, prm.start_time);
+        const double t_load = upper_body->load_time(t, cell.start_time);
         const double ramp   = k.ramp_time > 0 ? std::min(1.0, (t_load + prm.time_step) / k.ramp_time) : 1.0;
         normal_force                 = ramp * k.pressure * k.length;
         sliding                      = t >= k.shear_start;
@@ -79,6 +287,9 @@ namespace tribo::app
       }
 
       std::string description() const override { return upper_body->describe(); }
+      double      start_time() const override { return cell.start_time; }
+      std::string start_state() const override { return "the state of " + cell.initial_state; }
+      std::string plot_script() const override { return "plot_run.py"; }
 
       /// The grains and both walls; with a deformable upper body the grains and the lower
       /// wall (the body is not made of discs: a run from the sample puts its own upper
@@ -122,7 +333,7 @@ namespace tribo::app
 
         // Profiles from every step of the shearing phase, in blocks of block_steps steps
         // (Profile samples blocks over the planned shearing phase), each block one sample.
-        const auto &k = prm.shear;
+        const auto &k = cell;
         if (sliding)
           {
             const double        h       = prm.time_step;
@@ -151,7 +362,7 @@ namespace tribo::app
 
       void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
       {
-        const auto  &k     = prm.shear;
+        const auto  &k     = cell;
         const auto   time  = stats.column("time");
         const double t1    = time.back();
         j.set("sliding", sliding);
@@ -320,12 +531,12 @@ namespace tribo::app
                             const std::function<std::pair<unsigned int, double>()> &wall)
       {
         static_assert(LayerProfiles::no_body == coupling::FirstBody::no_system_body);
-        upper_body = coupling::make_first_body(prm.shear.upper_body, {s, surface, wall});
+        upper_body = coupling::make_first_body(cell.upper_body, {s, surface, wall});
       }
 
       double draw_diameter()
       {
-        const auto &k = prm.shear;
+        const auto &k = cell;
         std::uniform_real_distribution<double> u(1 - k.diameter_spread, 1 + k.diameter_spread);
         return k.mean_diameter * u(rng);
       }
@@ -335,7 +546,7 @@ namespace tribo::app
       /// diameter (both walls draw alike).
       std::pair<unsigned int, double> add_wall(dem::ParticleSystem &s, double y)
       {
-        const auto        &k = prm.shear;
+        const auto        &k = cell;
         // 0 wall discs: about L/d of them (d the mean or the given wall disc diameter),
         // and never more than fit along L when their diameter is given.
         const double d = k.wall_disc_diameter > 0 ? k.wall_disc_diameter : k.mean_diameter;
@@ -357,7 +568,7 @@ namespace tribo::app
       /// generated walls.
       void build_generated(dem::ParticleSystem &s)
       {
-        const auto  &k     = prm.shear;
+        const auto  &k     = cell;
         const double d_max = k.mean_diameter * (1 + k.diameter_spread);
         std::tie(lower, lower_wall_diameter) = add_wall(s, 0.0);
         for (auto &d : s.bodies[lower].drive)
@@ -381,7 +592,7 @@ namespace tribo::app
       /// walls below and above its grains; a deformable upper body in the upper wall's place.
       void build_from_sample(dem::ParticleSystem &s)
       {
-        const auto &k = prm.shear;
+        const auto &k = cell;
         using Body    = SampleDisc::Body;
         // A wall from its rows, moving as its first row says.
         auto wall_of = [&](Body body) {
@@ -472,6 +683,7 @@ namespace tribo::app
         return a;
       }
 
+      ShearCellParameters            cell;
       std::mt19937                   rng;
       unsigned int                   lower = 0;
       unsigned long                  steps_done = 0;
@@ -511,8 +723,26 @@ namespace tribo::app
     };
   } // namespace
 
-  std::unique_ptr<Scene> make_shear_scene(const CaseParameters &p)
+  std::unique_ptr<Scene> make_shear_scene(const ParameterFile &f, const CaseParameters &p)
   {
-    return std::make_unique<ShearCellScene>(p);
+    return std::make_unique<ShearCellScene>(p, ShearCellParameters::parse(f, p));
+  }
+
+  SceneHooks shear_hooks()
+  {
+    SceneHooks hooks{{ShearCellParameters::declare},
+                     [](const ParameterFile &f) { ShearCellParameters::parse(f, read_case_parameters(f)); },
+                     [](const ParameterFile &f, const CaseParameters &p, Log &log) {
+                       return make_nscd_simulation(p, make_shear_scene(f, p), log);
+                     }};
+    // The sample file and the initial state by their absolute paths.
+    hooks.resolve = [](ParameterFile &f) {
+      const auto cell = ShearCellParameters::parse(f, read_case_parameters(f));
+      if (!cell.sample_file.empty())
+        f.set("Shear cell/Sample file=" + cell.sample_file);
+      if (!cell.initial_state.empty())
+        f.set("Shear cell/Initial state=" + cell.initial_state);
+    };
+    return hooks;
   }
 } // namespace tribo::app

@@ -1,7 +1,7 @@
 // The SPH cantilever-plate scene (sph_plate): the clamped plate used to validate the
 // elastic solver (Gray, Monaghan and Swift 2001), an Experiment of the SPH family
 // (app/scenes/sph_family.h). 2D plane strain, SI units, per metre of depth.
-#include "app/particle_scenes.h"
+#include "app/scene_hooks.h"
 #include "app/scenes/sph_family.h"
 
 #include "sph/lattice.h"

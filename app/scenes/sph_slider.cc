@@ -5,7 +5,7 @@
 // SI units. The vertical axis is the last one (y in 2D, z in 3D); in 2D (plane strain)
 // forces are per metre of depth (N/m) and masses kg/m. Boundary forces are those of the
 // substrate on the block, upward (repulsive) positive.
-#include "app/particle_scenes.h"
+#include "app/scene_hooks.h"
 #include "app/scenes/sph_family.h"
 #include "app/steady_state.h"
 

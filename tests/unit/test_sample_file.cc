@@ -2,7 +2,7 @@
 // starts the same bodies, to the last bit for the grains.
 #include "app/case_parameters.h"
 #include "app/sample_file.h"
-#include "app/scene.h"
+#include "app/scene_hooks.h"
 #include "core/parameter_file.h"
 #include "dem/moreau_jean.h"
 
@@ -34,7 +34,7 @@ namespace
       for (const auto &s : settings)
         file.set(s);
       p     = app::read_case_parameters(file);
-      scene = app::make_scene(p);
+      scene = app::make_shear_scene(file, p);
       scene->build(system);
     }
   };

@@ -1,14 +1,14 @@
 #pragma once
-/// @file Scenes of the explicit particle modules (sph/, mlp/), one file each in
-/// app/scenes/, built as a Simulation that the driver (app/driver.h) runs like the NSCD
-/// scenes. Each scene file gives its row of the scene table (app/scenes.cc) its hooks
-/// (app/scenes.h): the declaration of its own subsection, the check of its entries
-/// without running it (an InputError naming the entry otherwise: `tribo check`, and
-/// `tribo run` before it writes anything) and its factory (what it built goes to the
-/// log). run_case() has prepared the output directory, written original.prm,
+/// @file Every scene's hooks, one function per scene file in app/scenes/: each gives its
+/// row of the scene table (app/scenes.cc) its hooks (app/scenes.h): the declaration of
+/// its own subsection, the check of its entries without running it (an InputError naming
+/// the entry otherwise: `tribo check`, and `tribo run` before it writes anything) and its
+/// factory of the Simulation that the driver (app/driver.h) runs (what it built goes to
+/// the log). run_case() has prepared the output directory, written original.prm,
 /// parameters.prm and a "running" summary.json, opened the log, and for --resume checked
 /// the checkpoint's parameters against the case.
 
+#include "app/scene.h"
 #include "app/scenes.h"
 #include "core/output.h"
 #include "core/parameter_file.h"
@@ -19,6 +19,11 @@ namespace tribo::app
 {
   struct CaseParameters; // app/case_parameters.h
 
+  SceneHooks collision_hooks(); ///< app/scenes/collision.cc, subsection "Collision"
+  SceneHooks shear_hooks();     ///< app/scenes/shear.cc, subsection "Shear cell"
+  /// The shear scene of the case @p p read from @p file, on its own, for the benchmarks
+  /// and tests that step it without the driver.
+  std::unique_ptr<Scene> make_shear_scene(const ParameterFile &file, const CaseParameters &p);
 #ifdef TRIBO_WITH_SPH_SCENES
   SceneHooks sph_slider_hooks(); ///< app/scenes/sph_slider.cc, subsection "SPH slider"
   SceneHooks sph_plate_hooks();  ///< app/scenes/sph_plate.cc, subsection "SPH plate"
