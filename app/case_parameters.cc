@@ -1,13 +1,8 @@
 #include "app/case_parameters.h"
 
-#include "app/scenes.h"
 #include "core/errors.h"
 
-#include <boost/property_tree/json_parser.hpp>
-#include <boost/property_tree/ptree.hpp>
-
 #include <cmath>
-#include <filesystem>
 
 namespace tribo::app
 {
@@ -15,11 +10,9 @@ namespace tribo::app
   using dealii::Patterns::Double;
   using dealii::Patterns::Integer;
 
-  void declare_case_parameters(dealii::ParameterHandler &prm)
+  void declare_common_parameters(dealii::ParameterHandler &prm)
   {
-    declare_scene_subsections(prm);
     prm.enter_subsection("Simulation");
-    declare_scene_entry(prm);
     prm.declare_entry("Time step", "1e-9", Double(), "Time step h, s (> 0).");
     prm.declare_entry("End time", "1e-6", Double(), "Simulated time, s (> 0).");
     prm.declare_entry("Theta", "0.5", Double(0.5, 1.0),
@@ -72,30 +65,4 @@ namespace tribo::app
     return p;
   }
 
-  RunRecord read_run_record(const std::string &dir)
-  {
-    namespace fs = std::filesystem;
-    RunRecord r;
-    try
-      {
-        boost::property_tree::ptree tree;
-        boost::property_tree::read_json((fs::path(dir) / "summary.json").string(), tree);
-        r.status         = tree.get<std::string>("status", "");
-        r.scene          = tree.get<std::string>("scene", "");
-        r.simulated_time = tree.get<double>("simulated_time", 0.0);
-      }
-    catch (const std::exception &)
-      {} // status "": no readable summary
-    try
-      {
-        dealii::ParameterHandler prm;
-        declare_case_parameters(prm);
-        ParameterFile parameters(prm);
-        parameters.parse((fs::path(dir) / "parameters.prm").string());
-        r.length = parameters.get_double("Shear cell/Length");
-      }
-    catch (const std::exception &)
-      {} // length 0: no readable parameters
-    return r;
-  }
 } // namespace tribo::app

@@ -3,7 +3,7 @@
 /// units) and validated reading into plain structs.
 
 #include "core/parameter_file.h"
-#include "dem/contact_law.h"
+#include "dem/laws/contact_law.h"
 #include "dem/solvers/contact_solver.h"
 
 #include <deal.II/base/parameter_handler.h>
@@ -29,19 +29,9 @@ namespace tribo::app
     unsigned int checkpoint_step_interval; ///< steps between checkpoints (0: none)
   };
 
-  /// What a finished run directory says of itself (its summary.json and parameters.prm),
-  /// for a case that goes on from it (Shear cell/Initial state) or exports its snapshots.
-  struct RunRecord
-  {
-    std::string status;             ///< summary.json "status" ("" if unreadable)
-    std::string scene;              ///< summary.json "scene"
-    double      simulated_time = 0; ///< s, summary.json "simulated_time"
-    double      length         = 0; ///< m, parameters.prm Shear cell/Length
-  };
-  RunRecord read_run_record(const std::string &dir);
-
-  /// Declare every entry of a case file.
-  void declare_case_parameters(dealii::ParameterHandler &prm);
+  /// Declare the entries every case has (Simulation, Contact law, Solver, Output): the
+  /// part of declare_case_parameters() (app/scenes.h) that is not a scene's.
+  void declare_common_parameters(dealii::ParameterHandler &prm);
 
   /// Read and check a parsed case's common entries (not the scene's own, which its row
   /// checks: app/scenes.h); InputError names the entry and what was expected.

@@ -1,6 +1,5 @@
 #include "app/driver.h"
 
-#include "app/run.h"
 #include "core/errors.h"
 #include "core/serialization.h"
 #include "core/run_control.h"
@@ -12,8 +11,74 @@
 
 namespace tribo::app
 {
+  RunCheckpoint::RunCheckpoint(const std::string &dir, std::map<std::string, std::string> resolved,
+                               double interval, unsigned long step_interval, bool resuming,
+                               std::string changes)
+    : path((std::filesystem::path(dir) / "checkpoint.bin").string())
+    , parameters(std::move(resolved))
+    , interval(interval)
+    , step_interval(step_interval)
+    , resume(resuming)
+    , changes(std::move(changes))
+    , start(Clock::now())
+    , last(start)
+  {}
+
+  bool RunCheckpoint::due(unsigned long step) const
+  {
+    const bool timer = interval > 0 && std::chrono::duration<double>(Clock::now() - last).count() > interval;
+    return timer || (step_interval > 0 && step % step_interval == 0);
+  }
+
+  void RunCheckpoint::write(const std::function<void(CheckpointOut &)> &save)
+  {
+    const double wall = wall_time();
+    write_checkpoint(path, [&](CheckpointOut &ar) {
+      ar << parameters << wall;
+      save(ar);
+    });
+    last = Clock::now();
+  }
+
+  void RunCheckpoint::read(Log &log, const std::function<void(CheckpointIn &)> &load)
+  {
+    read_checkpoint(path, [&](CheckpointIn &ar) {
+      std::map<std::string, std::string> saved; // checked by run_case() already
+      ar >> saved >> wall_before;
+      log("resuming from " + path + changes);
+      load(ar);
+    });
+  }
+
+  double RunCheckpoint::wall_time() const
+  {
+    return wall_before + std::chrono::duration<double>(Clock::now() - start).count();
+  }
+
+  void RunCheckpoint::remove() const { std::filesystem::remove(path); }
+
   namespace
   {
+    /// The end of every scene's run: log the error or the signal and return the exit code
+    /// (0 complete, 1 failed with @p failure, 128 + signal interrupted).
+  int finish_run(Log &log, const std::string &status, const std::string &failure);
+
+    int finish_run(Log &log, const std::string &status, const std::string &failure)
+    {
+      if (status == "failed")
+        {
+          log.error(failure);
+          return exit_run_error;
+        }
+      if (status == "interrupted")
+        {
+          log("interrupted by signal " + std::to_string(stop_requested()) +
+              ": outputs hold the steps done so far");
+          return 128 + stop_requested();
+        }
+      return exit_ok;
+    }
+
     /// statistics.csv as rows of "time", "step" and the simulation's columns; the column
     /// names are those of the first row (a resumed run's come from its checkpoint).
     class Statistics

@@ -74,7 +74,7 @@ namespace tribo::app
     {
       unsigned long total_iterations = 0, non_converged = 0, max_iterations = 0;
       double        worst_overlap = 0, max_residual = 0, max_speed = 0;
-      /// The law residual (dem/law_residual.h) over the steps, and the active set's work.
+      /// The law residual (dem/laws/law_residual.h) over the steps, and the active set's work.
       double        max_law_residual = 0, sum_law_residual = 0, max_gap_violation = 0;
       unsigned long total_factorizations = 0, fallbacks = 0, gap_exceeded = 0;
 

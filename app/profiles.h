@@ -29,8 +29,8 @@
 ///   their mean velocity in that layer at that step, m^2/s^2 (0 for fewer than 2 discs).
 
 #include "core/checkpoint.h"
-#include "dem/moreau_jean.h"
-#include "dem/particle_system.h"
+#include "dem/engine/moreau_jean.h"
+#include "dem/engine/particle_system.h"
 
 #include <string>
 #include <utility>

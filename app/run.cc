@@ -82,52 +82,6 @@ namespace tribo::app
            (defaulted.empty() ? "" : "; not in the checkpoint, at their defaults: " + defaulted);
   }
 
-  RunCheckpoint::RunCheckpoint(const std::string &dir, std::map<std::string, std::string> resolved,
-                               double interval, unsigned long step_interval, bool resuming,
-                               std::string changes)
-    : path((fs::path(dir) / "checkpoint.bin").string())
-    , parameters(std::move(resolved))
-    , interval(interval)
-    , step_interval(step_interval)
-    , resume(resuming)
-    , changes(std::move(changes))
-    , start(Clock::now())
-    , last(start)
-  {}
-
-  bool RunCheckpoint::due(unsigned long step) const
-  {
-    const bool timer = interval > 0 && std::chrono::duration<double>(Clock::now() - last).count() > interval;
-    return timer || (step_interval > 0 && step % step_interval == 0);
-  }
-
-  void RunCheckpoint::write(const std::function<void(CheckpointOut &)> &save)
-  {
-    const double wall = wall_time();
-    write_checkpoint(path, [&](CheckpointOut &ar) {
-      ar << parameters << wall;
-      save(ar);
-    });
-    last = Clock::now();
-  }
-
-  void RunCheckpoint::read(Log &log, const std::function<void(CheckpointIn &)> &load)
-  {
-    read_checkpoint(path, [&](CheckpointIn &ar) {
-      std::map<std::string, std::string> saved; // checked by run_case() already
-      ar >> saved >> wall_before;
-      log("resuming from " + path + changes);
-      load(ar);
-    });
-  }
-
-  double RunCheckpoint::wall_time() const
-  {
-    return wall_before + std::chrono::duration<double>(Clock::now() - start).count();
-  }
-
-  void RunCheckpoint::remove() const { fs::remove(path); }
-
   std::string run_status(const std::string &dir)
   {
     try
@@ -282,19 +236,4 @@ namespace tribo::app
     return drive(*simulation, settings, summary, log, checkpoint);
   }
 
-  int finish_run(Log &log, const std::string &status, const std::string &failure)
-  {
-    if (status == "failed")
-      {
-        log.error(failure);
-        return exit_run_error;
-      }
-    if (status == "interrupted")
-      {
-        log("interrupted by signal " + std::to_string(stop_requested()) +
-            ": outputs hold the steps done so far");
-        return 128 + stop_requested();
-      }
-    return exit_ok;
-  }
 } // namespace tribo::app

@@ -30,56 +30,9 @@ namespace tribo::app
     std::string              resume_dir;
   };
 
-  /// The checkpoints of one run, written and read by the driver (app/driver.h): where they go
-  /// (DIR/checkpoint.bin), when one is due (every Output/Checkpoint interval seconds of wall
-  /// time and every Output/Checkpoint step interval steps), what each starts with (the
-  /// resolved parameters, which run_case() compares with the case through
-  /// resume_changes() before anything is written, then the wall time of the run so far)
-  /// and its removal once the run is complete. The loop saves and loads its own state
-  /// after that header, in one order.
-  class RunCheckpoint
-  {
-  public:
-    /// @p interval wall seconds and @p step_interval steps between checkpoints (0: none of
-    /// that kind); @p changes the log text of resume_changes() when @p resuming.
-    RunCheckpoint(const std::string &dir, std::map<std::string, std::string> resolved,
-                  double interval, unsigned long step_interval, bool resuming, std::string changes);
-
-    /// True for a run continued with --resume: the loop loads its state with read().
-    bool resuming() const { return resume; }
-    /// True if a checkpoint is due after step @p step: the wall interval has passed since
-    /// the last one (or the start), or @p step is a multiple of the step interval.
-    bool due(unsigned long step) const;
-    /// Write the checkpoint (atomically): the header, then @p save. Restarts the timer.
-    void write(const std::function<void(CheckpointOut &)> &save);
-    /// Read the checkpoint: the header (logged as "resuming from FILE" and the changes),
-    /// then @p load; the wall time of the run before it goes on in wall_time().
-    void read(Log &log, const std::function<void(CheckpointIn &)> &load);
-    /// Wall time of the run so far, s: this process's plus that of the processes before
-    /// the resumption.
-    double wall_time() const;
-    /// Remove the checkpoint: call once the run is complete.
-    void remove() const;
-
-  private:
-    using Clock = std::chrono::steady_clock;
-    std::string                        path;
-    std::map<std::string, std::string> parameters;
-    double                             interval;
-    unsigned long                      step_interval;
-    bool                               resume;
-    std::string                        changes;
-    Clock::time_point                  start, last;
-    double                             wall_before = 0; ///< s, of the processes before
-  };
-
   /// Run (or only check) a case; returns the process exit code. Input errors
   /// are thrown as InputError before anything is written.
   int run_case(const RunOptions &options);
-
-  /// The end of every scene's run: log the error or the signal and return the exit code
-  /// (0 complete, 1 failed with @p failure, 128 + signal interrupted).
-  int finish_run(Log &log, const std::string &status, const std::string &failure);
 
   /// The "status" of DIR/summary.json (running, complete, interrupted, failed), or "" if
   /// there is none or it cannot be read.

@@ -1,6 +1,6 @@
 #include "app/sample_file.h"
 
-#include "app/case_parameters.h"
+#include "app/scenes.h"
 #include "core/errors.h"
 
 #include <algorithm>

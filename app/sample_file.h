@@ -13,7 +13,7 @@
 /// upper wall or body then goes above the grains), and walls that overlap (the upper wall's
 /// lowest point below the lower wall's highest).
 
-#include "dem/particle_system.h"
+#include "dem/engine/particle_system.h"
 
 #include <string>
 #include <vector>

@@ -5,8 +5,8 @@
 #include "app/case_parameters.h"
 #include "app/driver.h"
 #include "core/output.h"
-#include "dem/moreau_jean.h"
-#include "dem/particle_system.h"
+#include "dem/engine/moreau_jean.h"
+#include "dem/engine/particle_system.h"
 
 #include <map>
 #include <memory>

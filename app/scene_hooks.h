@@ -1,6 +1,6 @@
 #pragma once
 /// @file Every scene's hooks, one function per scene file in app/scenes/: each gives its
-/// row of the scene table (app/scenes.cc) its hooks (app/scenes.h): the declaration of
+/// row of the scene table (app/scenes.h, app/scenes.cc) its hooks (SceneHooks): the declaration of
 /// its own subsection, the check of its entries without running it (an InputError naming
 /// the entry otherwise: `tribo check`, and `tribo run` before it writes anything) and its
 /// factory of the Simulation that the driver (app/driver.h) runs (what it built goes to
@@ -8,16 +8,37 @@
 /// parameters.prm and a "running" summary.json, opened the log, and for --resume checked
 /// the checkpoint's parameters against the case.
 
+#include "app/driver.h"
 #include "app/scene.h"
-#include "app/scenes.h"
 #include "core/output.h"
 #include "core/parameter_file.h"
 
+#include <deal.II/base/parameter_handler.h>
+
 #include <memory>
+#include <vector>
 
 namespace tribo::app
 {
   struct CaseParameters; // app/case_parameters.h
+
+  /// What a scene of this build gives the table: its subsections, its check, its factory.
+  struct SceneHooks
+  {
+    /// Declare the scene's subsections, each function one subsection (a subsection that
+    /// scenes share, such as "MLP", is the same function in their rows and is declared
+    /// once); empty: none beyond the NSCD subsections.
+    std::vector<void (*)(dealii::ParameterHandler &)> declare;
+    /// Reads and checks the scene's own entries without building it (InputError naming
+    /// the entry), before anything is written; nullptr: it has none.
+    void (*check)(const ParameterFile &) = nullptr;
+    /// Builds the scene (what it built goes to the log); nullptr: not in this build.
+    std::unique_ptr<Simulation> (*make)(const ParameterFile &, const CaseParameters &, Log &) = nullptr;
+    /// Rewrites the entries whose meaning depends on where the case file is (a relative
+    /// path, as an absolute one), so that parameters.prm means the same from any
+    /// directory (a resumed run, a run started from it elsewhere); nullptr: none.
+    void (*resolve)(ParameterFile &) = nullptr;
+  };
 
   SceneHooks collision_hooks(); ///< app/scenes/collision.cc, subsection "Collision"
   SceneHooks shear_hooks();     ///< app/scenes/shear.cc, subsection "Shear cell"

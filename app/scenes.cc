@@ -1,9 +1,15 @@
 #include "app/scenes.h"
 
+#include "app/case_parameters.h"
 #include "app/scene_hooks.h"
 #include "core/errors.h"
+#include "core/parameter_file.h"
+
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
 
 #include <algorithm>
+#include <filesystem>
 
 namespace tribo::app
 {
@@ -65,19 +71,28 @@ namespace tribo::app
     throw std::logic_error("scene_named: no scene '" + name + "' (Simulation/Scene's Selection allowed it)");
   }
 
-  void declare_scene_entry(dealii::ParameterHandler &prm)
+  namespace
   {
-    std::string names, text = "What to simulate: ";
-    for (const SceneEntry &s : scenes())
-      {
-        names += (names.empty() ? "" : "|") + s.name;
-        text += (&s == &scenes().front() ? "'" : "; '") + s.name + "' (" + s.description + ")";
-      }
-    prm.declare_entry("Scene", "shear", dealii::Patterns::Selection(names), text + ".");
-  }
+    /// The entry Scene (Selection and documentation from scenes()) in the current
+    /// subsection (Simulation).
+    void declare_scene_entry(dealii::ParameterHandler &prm)
+    {
+      std::string names, text = "What to simulate: ";
+      for (const SceneEntry &s : scenes())
+        {
+          names += (names.empty() ? "" : "|") + s.name;
+          text += (&s == &scenes().front() ? "'" : "; '") + s.name + "' (" + s.description + ")";
+        }
+      prm.declare_entry("Scene", "shear", dealii::Patterns::Selection(names), text + ".");
+    }
+  } // namespace
 
-  void declare_scene_subsections(dealii::ParameterHandler &prm)
+  void declare_case_parameters(dealii::ParameterHandler &prm)
   {
+    declare_common_parameters(prm);
+    prm.enter_subsection("Simulation");
+    declare_scene_entry(prm);
+    prm.leave_subsection();
     std::vector<void (*)(dealii::ParameterHandler &)> declared;
     for (const SceneEntry &s : scenes())
       for (const auto declare : s.hooks.declare)
@@ -86,5 +101,32 @@ namespace tribo::app
             declare(prm);
             declared.push_back(declare);
           }
+  }
+
+  RunRecord read_run_record(const std::string &dir)
+  {
+    namespace fs = std::filesystem;
+    RunRecord r;
+    try
+      {
+        boost::property_tree::ptree tree;
+        boost::property_tree::read_json((fs::path(dir) / "summary.json").string(), tree);
+        r.status         = tree.get<std::string>("status", "");
+        r.scene          = tree.get<std::string>("scene", "");
+        r.simulated_time = tree.get<double>("simulated_time", 0.0);
+      }
+    catch (const std::exception &)
+      {} // status "": no readable summary
+    try
+      {
+        dealii::ParameterHandler prm;
+        declare_case_parameters(prm);
+        ParameterFile parameters(prm);
+        parameters.parse((fs::path(dir) / "parameters.prm").string());
+        r.length = parameters.get_double("Shear cell/Length");
+      }
+    catch (const std::exception &)
+      {} // length 0: no readable parameters
+    return r;
   }
 } // namespace tribo::app

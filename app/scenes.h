@@ -5,7 +5,7 @@
 /// to build all come from it; a scene whose module the build left out keeps its row, so
 /// that a case naming it is refused with the build option it needs.
 
-#include "app/driver.h"
+#include "app/scene_hooks.h"
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -13,33 +13,8 @@
 #include <string>
 #include <vector>
 
-namespace tribo
-{
-  class ParameterFile; // core/parameter_file.h
-}
-
 namespace tribo::app
 {
-  struct CaseParameters; // app/case_parameters.h
-
-  /// What a scene of this build gives the table: its subsections, its check, its factory.
-  struct SceneHooks
-  {
-    /// Declare the scene's subsections, each function one subsection (a subsection that
-    /// scenes share, such as "MLP", is the same function in their rows and is declared
-    /// once); empty: none beyond the NSCD subsections.
-    std::vector<void (*)(dealii::ParameterHandler &)> declare;
-    /// Reads and checks the scene's own entries without building it (InputError naming
-    /// the entry), before anything is written; nullptr: it has none.
-    void (*check)(const ParameterFile &) = nullptr;
-    /// Builds the scene (what it built goes to the log); nullptr: not in this build.
-    std::unique_ptr<Simulation> (*make)(const ParameterFile &, const CaseParameters &, Log &) = nullptr;
-    /// Rewrites the entries whose meaning depends on where the case file is (a relative
-    /// path, as an absolute one), so that parameters.prm means the same from any
-    /// directory (a resumed run, a run started from it elsewhere); nullptr: none.
-    void (*resolve)(ParameterFile &) = nullptr;
-  };
-
   struct SceneEntry
   {
     std::string name;        ///< the value of Simulation/Scene
@@ -57,10 +32,21 @@ namespace tribo::app
   /// The scene @p name (a value Simulation/Scene's Selection allowed).
   const SceneEntry &scene_named(const std::string &name);
 
-  /// Declare the entry Scene (Selection and documentation from scenes()) in the current
-  /// subsection (Simulation).
-  void declare_scene_entry(dealii::ParameterHandler &prm);
+  /// Declare every entry of a case file: the common ones (app/case_parameters.h) and every
+  /// built scene's own subsections (each module's once).
+  void declare_case_parameters(dealii::ParameterHandler &prm);
 
-  /// Declare every built scene's own subsections (each module's once).
-  void declare_scene_subsections(dealii::ParameterHandler &prm);
+  /// What a finished run directory says of itself (its summary.json and parameters.prm),
+  /// for a case that goes on from it (Shear cell/Initial state) or exports its snapshots.
+  struct RunRecord
+  {
+    std::string status;             ///< summary.json "status" ("" if unreadable)
+    std::string scene;              ///< summary.json "scene"
+    double      simulated_time = 0; ///< s, summary.json "simulated_time"
+    double      length         = 0; ///< m, parameters.prm Shear cell/Length
+  };
+  RunRecord read_run_record(const std::string &dir);
+
+  /// Declare every entry of a case file.
+  void declare_case_parameters(dealii::ParameterHandler &prm);
 } // namespace tribo::app

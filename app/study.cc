@@ -1,6 +1,6 @@
 #include "app/study.h"
 
-#include "app/case_parameters.h"
+#include "app/scenes.h"
 #include "app/run.h"
 #include "core/errors.h"
 #include "core/output.h"

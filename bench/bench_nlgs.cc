@@ -8,8 +8,9 @@
 // (bench/nlgs_scaling.sh runs it on 1k to 64k discs.)
 #include "app/case_parameters.h"
 #include "app/scene_hooks.h"
+#include "app/scenes.h"
 #include "core/parameter_file.h"
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <chrono>
 #include <cstdio>

@@ -11,7 +11,7 @@
 /// Units per unit depth: m, kg/m, N/m, J/m, W/m.
 
 #include "coupling/first_body.h"
-#include "dem/boundary.h"
+#include "dem/engine/boundary.h"
 
 #include <memory>
 #include <string>

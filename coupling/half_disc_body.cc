@@ -1,10 +1,10 @@
 /// @file Any deformable model as the scene's FirstBody: the DeformableBody touched by the
-/// grains through half-disc elements on its bottom face (dem/boundary.h), their bottom on
+/// grains through half-disc elements on its bottom face (dem/engine/boundary.h), their bottom on
 /// the placement's surface.
 
 #include "coupling/models.h"
 
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <cmath>
 

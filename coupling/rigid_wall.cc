@@ -5,7 +5,7 @@
 #include "coupling/models.h"
 
 #include "core/parameter_file.h"
-#include "dem/particle_system.h"
+#include "dem/engine/particle_system.h"
 
 #include <deal.II/base/parameter_handler.h>
 

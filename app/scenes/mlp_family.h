@@ -9,7 +9,7 @@
 /// energies J/m). x is the axis of the loads (left-right), y the transverse axis.
 
 #include "app/driver.h"
-#include "app/scenes.h"
+#include "app/scene_hooks.h"
 #include "core/parameter_file.h"
 #include "mlp/interaction.h"
 #include "mlp/langevin.h"

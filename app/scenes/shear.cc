@@ -14,7 +14,7 @@
 #include "app/profiles.h"
 #include "app/sample_file.h"
 #include "app/scene.h"
-#include "app/scene_hooks.h"
+#include "app/scenes.h"
 #include "app/steady_state.h"
 #include "core/errors.h"
 

@@ -1,11 +1,11 @@
 #pragma once
 /// @file The active-set (projected Newton) method for the frictionless contact problem,
-/// on the sparse Delassus operator (dem/solvers/delassus.h).
+/// on the sparse Delassus operator (dem/linalg/delassus.h).
 ///
 /// With x = r~ = r_n + gamma h the shifted normal impulses (N s/m) and
 ///     w = A x + b,  A = W_nn + C,  b = u_free,n + shift - W_nn (gamma h)
 /// the law's normal velocities (m/s; C the ELAS compliances, 0 for IQS; shift the law's
-/// gap term, dem/contact_law.h), both laws are the linear complementarity problem
+/// gap term, dem/laws/contact_law.h), both laws are the linear complementarity problem
 ///     0 <= x  _|_  w >= 0,
 /// i.e. the minimum of f(x) = x.A x / 2 + b.x over x >= 0 (A symmetric positive
 /// semidefinite; w is f's gradient). Bertsekas' projected Newton method (1982):

@@ -1,6 +1,6 @@
 #include "dem/solvers/apgd.h"
 
-#include "dem/solvers/scaled_operator.h"
+#include "dem/linalg/scaled_operator.h"
 
 #include <algorithm>
 #include <cmath>

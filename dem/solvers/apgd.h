@@ -21,10 +21,10 @@
 /// close in bulk, and its iterations follow the square root of the operator's condition
 /// number (MPRGP's expansion steps degenerate into fixed-step gradient steps in steady
 /// shear, docs/performance.md). The products and sums run over fixed chunks of the
-/// contacts (dem/solvers/scaled_operator.h): the same bits on any number of threads.
+/// contacts (dem/linalg/scaled_operator.h): the same bits on any number of threads.
 ///
 /// It stops when the natural map max_i |min(x_i, w_i / A_ii)| = max_i |min(y_i, g_i)| /
-/// sqrt(D_i) (the law residual's measure, dem/law_residual.h, at the iterate y_k, known
+/// sqrt(D_i) (the law residual's measure, dem/laws/law_residual.h, at the iterate y_k, known
 /// every iteration) is at most SolverParameters::residual_target times the iterate's mean
 /// loaded impulse, or after SolverParameters::max_iterations products with the operator
 /// (the power iterations counted); it then keeps its last iterate, x >= 0, and reports not

@@ -1,6 +1,6 @@
 #include "dem/solvers/apgs.h"
 
-#include "dem/solvers/scaled_operator.h"
+#include "dem/linalg/scaled_operator.h"
 #include "dem/solvers/sweep_problem.h"
 
 #include <deal.II/base/parallel.h>
@@ -101,7 +101,7 @@ namespace tribo::dem
 
     /// Contact j's natural map in N s/m, y's rows set in op and @p g_n its normal row of
     /// A'y + b': without friction |min(y_j, g_j)| / sqrt(D_j); with friction the norm of
-    /// (phi_n, phi_t) of dem/law_residual.h in the scaled variables (unit normal diagonal,
+    /// (phi_n, phi_t) of dem/laws/law_residual.h in the scaled variables (unit normal diagonal,
     /// tangent diagonal A'_tt), times the contact's scale.
     double ApgsRun::contact_map(const Eigen::VectorXd &y, Eigen::Index j, double g_n) const
     {
@@ -198,7 +198,7 @@ namespace tribo::dem
       return sums.worst / mean_loaded;
     }
 
-    /// A whole check at y: one pass over fixed chunks (dem/solvers/scaled_operator.h),
+    /// A whole check at y: one pass over fixed chunks (dem/linalg/scaled_operator.h),
     /// concurrently with Threads > 1; the chunks' sums are kept for the check after a polish.
     double ApgsRun::relative_map(const Eigen::VectorXd &y)
     {

@@ -41,7 +41,7 @@
 /// polish works on it alone (docs/performance.md, "APGS's local polish").
 ///
 /// With friction a contact is two rows (normal, tangent) and its natural map the norm of
-/// (phi_n, phi_t) of dem/law_residual.h, so the stopping test is the law residual itself.
+/// (phi_n, phi_t) of dem/laws/law_residual.h, so the stopping test is the law residual itself.
 /// The 2D Coulomb law is not associated: the sweep is no projected gradient step of a
 /// potential and the momentum has no guarantee. A safeguard keeps the best iterate of the
 /// whole checks and drops the momentum (t = 1, z = y) when a block of sweeps raises the map;

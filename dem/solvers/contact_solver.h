@@ -6,9 +6,9 @@
 /// entries, its constructor).
 
 #include "core/parameter_section.h"
-#include "dem/body_state.h"
-#include "dem/contact.h"
-#include "dem/contact_law.h"
+#include "dem/engine/body_state.h"
+#include "dem/engine/contact.h"
+#include "dem/laws/contact_law.h"
 
 #include <memory>
 #include <string>
@@ -56,7 +56,7 @@ namespace tribo::dem
     unsigned int max_factorizations = 50;
     /// Global methods: the solve ends when the natural map max |min(x, w / W_nn)|
     /// (dem/solvers/frictionless_problem.h) is below this times the iterate's mean loaded impulse
-    /// (the law residual, dem/law_residual.h; the active set and the interior-point method
+    /// (the law residual, dem/laws/law_residual.h; the active set and the interior-point method
     /// also stop at their round-off floors). The default, 1e-3, is below the 1.2-1.5e-3
     /// NLGS leaves on average at Quad 1e-4 in steady shear: at 1.5e-3 MPRGP let an overlap
     /// grow past a radius on the 3800-grain benchmark (docs/performance.md).
@@ -148,7 +148,7 @@ namespace tribo::dem
     /// Whether NLGS solved the step (the method is NLGS, or it handed a frictional step
     /// to NLGS, or the active set fell back): residual is then NLGS's criterion.
     bool solved_by_nlgs = false;
-    /// The law residual after the solve (dem/law_residual.h), max |phi| / mean loaded
+    /// The law residual after the solve (dem/laws/law_residual.h), max |phi| / mean loaded
     /// impulse: the same measure whatever the method.
     double law_residual = 0;
     /// Convergence checks done: passes of local solves that apply nothing, one every

@@ -9,7 +9,7 @@
 ///   impulses that close C exactly (the interior point's crossover; from APGD's or APGS's
 ///   iterates it fails, docs/performance.md).
 
-#include "dem/solvers/bisected_cholesky.h"
+#include "dem/linalg/bisected_cholesky.h"
 #include "dem/solvers/frictionless_problem.h"
 
 #include <Eigen/CholmodSupport>
@@ -22,7 +22,7 @@ namespace tribo::dem
   /// LL^T: twice as fast as its supernodal one with Debian's reference BLAS on the
   /// 3800-grain benchmark, docs/performance.md); given a @p partition of its rows (from 4000
   /// contacts, with a small separator), in two halves on both cores
-  /// (dem/solvers/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
+  /// (dem/linalg/bisected_cholesky.h). The symbolic analysis is made once, by the constructor;
   /// each factorise() is one numeric factorisation. Whole, K is kept as the upper triangle
   /// of P K P^T (permuted_upper()), P the fill-reducing ordering, so that CHOLMOD
   /// factorises it as given: with its own ordering it would transpose K at every

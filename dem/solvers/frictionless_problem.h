@@ -5,16 +5,16 @@
 /// With x = r~ = r_n + gamma h the shifted normal impulses (N s/m) and
 ///     w = A x + b,  A = W_nn + C,  b = u_free,n + shift - W_nn (gamma h)
 /// the law's normal velocities (m/s; W_nn the normal part of the sparse Delassus operator,
-/// dem/solvers/delassus.h; C the diagonal ELAS compliances 1/(theta k h^2), 0 for IQS; shift the
-/// law's gap term, dem/contact_law.h), both IQS and ELAS are
+/// dem/linalg/delassus.h; C the diagonal ELAS compliances 1/(theta k h^2), 0 for IQS; shift the
+/// law's gap term, dem/laws/contact_law.h), both IQS and ELAS are
 ///     0 <= x  _|_  w >= 0,
 /// i.e. the minimum over x >= 0 of the contact energy f(x) = x.A x / 2 + b.x, whose
 /// gradient is w (A is symmetric positive semidefinite). The natural map
 ///     phi_i = min(x_i, w_i / A_ii)      (N s/m)
-/// is zero exactly at a solution; it is the law residual's phi_n (dem/law_residual.h).
+/// is zero exactly at a solution; it is the law residual's phi_n (dem/laws/law_residual.h).
 
-#include "dem/contact.h"
-#include "dem/contact_law.h"
+#include "dem/engine/contact.h"
+#include "dem/laws/contact_law.h"
 
 #include <Eigen/Core>
 #include <Eigen/Dense>
@@ -31,7 +31,7 @@ namespace tribo::dem
     /// The problem of @p contacts against @p state, whose velocities must already hold the
     /// contacts' warm-start impulses c.r; x starts at max(0, r_n + gamma h). With
     /// @p low_rank_bodies, the bodies with many contacts (walls) are kept out of A as the
-    /// columns U (dem/solvers/delassus.h): the operator is A + U U^T.
+    /// columns U (dem/linalg/delassus.h): the operator is A + U U^T.
     FrictionlessProblem(const std::vector<Contact> &contacts, const BodyState &state,
                         bool low_rank_bodies = false);
 
@@ -55,7 +55,7 @@ namespace tribo::dem
       return U.cols() > 0 ? Eigen::VectorXd(A * v + U * (U.transpose() * v)) : Eigen::VectorXd(A * v);
     }
     /// The mean of the positive entries of @p y (N s/m), or scale without one: the
-    /// denominator of the law residual (dem/law_residual.h).
+    /// denominator of the law residual (dem/laws/law_residual.h).
     double mean_loaded(const Eigen::VectorXd &y) const;
     /// max_i |min(y_i, w_i / A_ii)| with w = A y + b given, N s/m.
     double natural_map(const Eigen::VectorXd &y, const Eigen::VectorXd &w) const;

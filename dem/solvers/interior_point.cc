@@ -77,7 +77,7 @@ namespace tribo::dem
       double                      best_worst = 0;
       Eigen::VectorXd             best_y, best_g;
 
-      /// The operator A' + U U^T (the walls as low-rank columns, dem/solvers/delassus.h).
+      /// The operator A' + U U^T (the walls as low-rank columns, dem/linalg/delassus.h).
       Eigen::VectorXd product(const Eigen::VectorXd &v) const { return scaled.product(v); }
       Eigen::VectorXd newton_solve(const Eigen::VectorXd &v) { return K.solve(v, refine_now); }
       double          natural_map() const;

@@ -11,7 +11,7 @@
 ///                             redundancy of the contacts: no regularisation needed)
 /// (CHOLMOD's simplicial LL^T: faster than its supernodal one with reference BLAS here).
 /// A wall clump touched by m contacts would make an m x m dense block of K; it is kept
-/// out as the rank-1..3 term U U^T (dem/solvers/delassus.h, bodies with more than 64 contacts),
+/// out as the rank-1..3 term U U^T (dem/linalg/delassus.h, bodies with more than 64 contacts),
 /// K_s = K - U U^T is factorised and K solved by Sherman-Morrison-Woodbury with one step
 /// of iterative refinement (1.7 times faster per step at 16 000 grains, docs/performance.md);
 /// - predictor: K dy = -r - s, ds = A' dy + r; the largest step alpha_a that keeps y, s >= 0

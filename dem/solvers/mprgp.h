@@ -9,7 +9,7 @@
 /// Preconditioning by the diagonal D of A, as a change of variables y = D^(1/2) x:
 /// the problem in y has A' = D^(-1/2) A D^(-1/2) (unit diagonal), b' = D^(-1/2) b and the
 /// same bounds y >= 0; the gradient is g = A' y + b' = D^(-1/2) w. The walls (bodies with
-/// more than LowRankBodies::contact_limit contacts, dem/solvers/delassus.h) are kept out of the
+/// more than LowRankBodies::contact_limit contacts, dem/linalg/delassus.h) are kept out of the
 /// sparse matrix as low-rank columns, A' = A'_sparse + U'U'^T: a product then costs
 /// O(nnz(A'_sparse) + n k) (k: the walls' free dofs) instead of a dense block per wall.
 /// With F = {i : y_i > 0} (free) and the others active, the free gradient phi_i = g_i on
@@ -28,7 +28,7 @@
 ///
 /// It stops when the natural map max_i |min(x_i, w_i / A_ii)| = max_i |min(y_i, g_i)| /
 /// sqrt(D_i) is at most SolverParameters::residual_target times the iterate's mean loaded
-/// impulse (the law residual's measure, dem/law_residual.h), or after SolverParameters::max_iterations products with A' (each
+/// impulse (the law residual's measure, dem/laws/law_residual.h), or after SolverParameters::max_iterations products with A' (each
 /// about the cost of one NLGS sweep); it then keeps its last iterate, which satisfies
 /// x >= 0, and reports not converged.
 

@@ -1,7 +1,7 @@
 #include "dem/solvers/sweep_problem.h"
 
-#include "dem/solvers/delassus.h"
-#include "dem/body_state.h"
+#include "dem/linalg/delassus.h"
+#include "dem/engine/body_state.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,9 +6,9 @@
 /// the operator A' + U'U'^T with a unit diagonal.
 ///
 /// Coulomb friction mu (width 2): contact i has rows 2i (normal) and 2i + 1 (tangent) of the
-/// full Delassus operator (dem/solvers/delassus.h), x = (r~_n, r_t) = (r_n + gamma h, r_t) (N s/m),
+/// full Delassus operator (dem/linalg/delassus.h), x = (r~_n, r_t) = (r_n + gamma h, r_t) (N s/m),
 ///     u~ = (W + C) x + b,  b = u_free + (shift, 0) - W (gamma h, 0)      (m/s),
-/// with C the ELAS compliance on the normal rows (dem/contact_law.h). Both components of a
+/// with C the ELAS compliance on the normal rows (dem/laws/contact_law.h). Both components of a
 /// contact share one scale s_i = (W_nn,i + C_i)^(-1/2): y = x / s_i, A' = S (W + C) S,
 /// b' = S b, so that the normal diagonal is 1 and the cone |y_t| <= mu y_n is the law's own.
 /// The law of each contact (0 <= y_n _|_ u~_n >= 0, |y_t| <= mu y_n, u_t = 0 while

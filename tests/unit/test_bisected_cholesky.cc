@@ -1,7 +1,7 @@
-// The two-way split Cholesky factorisation (dem/solvers/bisected_cholesky.h) against the whole
+// The two-way split Cholesky factorisation (dem/linalg/bisected_cholesky.h) against the whole
 // factor (the interior point on two threads: tests/unit/test_contact_solvers.cc), and the
 // whole factor of the interior point's Newton matrix (dem/solvers/crossover.h).
-#include "dem/solvers/bisected_cholesky.h"
+#include "dem/linalg/bisected_cholesky.h"
 #include "dem/solvers/crossover.h"
 
 #include <Eigen/SparseCholesky>

@@ -1,7 +1,7 @@
-// Half-disc elements and the BoundaryBody coupling interface (dem/boundary.h),
+// Half-disc elements and the BoundaryBody coupling interface (dem/engine/boundary.h),
 // against a chain of lumped point masses whose compliance is diagonal.
-#include "dem/boundary.h"
-#include "dem/moreau_jean.h"
+#include "dem/engine/boundary.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
 // The sparse Delassus operator, the law residual and the active-set method against
 // the dense operator, closed forms and NLGS converged to 1e-12.
 #include "dem/solvers/apgs.h"
-#include "dem/solvers/bisected_cholesky.h"
-#include "dem/solvers/delassus.h"
+#include "dem/linalg/bisected_cholesky.h"
+#include "dem/linalg/delassus.h"
 #include "dem/solvers/frictionless_problem.h"
-#include "dem/law_residual.h"
-#include "dem/moreau_jean.h"
+#include "dem/laws/law_residual.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <Eigen/Dense>
 
@@ -196,7 +196,7 @@ TEST(ContactSolvers, GlobalMethodsWithTheWallAsLowRankMatchConvergedNlgs)
 {
   // 36 columns: the upper wall carries more than 64 contacts, so the interior-point
   // method solves through Sherman-Morrison-Woodbury and MPRGP multiplies by
-  // A_sparse + U U^T (dem/solvers/delassus.h).
+  // A_sparse + U U^T (dem/linalg/delassus.h).
   const ParticleSystem s = hexagonal_stack(3600, 2, 36);
   {
     ParticleSystem probe = s;

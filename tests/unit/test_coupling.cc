@@ -5,7 +5,7 @@
 #include "coupling/first_body.h"
 #include "coupling/first_body_models.h"
 #include "core/errors.h"
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // The own Delassus block of a contact and the exchange of impulses through
 // body velocities, against a dense W = H^T M^-1 H.
 #include "dem/solvers/nlgs.h"
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <Eigen/Dense>
 

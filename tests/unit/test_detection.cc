@@ -1,7 +1,7 @@
 // Cell-list detection against brute force, with and without x-periodicity, and the
 // threaded search against the serial one.
 #include "core/errors.h"
-#include "dem/contact.h"
+#include "dem/engine/contact.h"
 
 #include <gtest/gtest.h>
 

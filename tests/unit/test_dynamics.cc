@@ -1,6 +1,6 @@
 // Moreau-Jean stepping against closed-form mechanics.
 #include "core/errors.h"
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <gtest/gtest.h>
 

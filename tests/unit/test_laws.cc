@@ -1,5 +1,5 @@
-// Closed-form local solves of the IQS and ELAS laws (dem/contact_law.h).
-#include "dem/contact_law.h"
+// Closed-form local solves of the IQS and ELAS laws (dem/laws/contact_law.h).
+#include "dem/laws/contact_law.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // The banded NLGS (SolverParameters::threads > 1) and the interleaved streams: each is the
 // serial Gauss-Seidel sweep in its own order, bit for bit, and a banded run solves the
 // law as the serial run does.
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <gtest/gtest.h>
 
@@ -267,6 +267,6 @@ TEST(NlgsBands, MprgpGivesTheSameStateOnAnyNumberOfThreads)
 
 TEST(NlgsBands, ApgdGivesTheSameStateOnAnyNumberOfThreads)
 {
-  // APGD's passes run over the same fixed chunks (dem/solvers/scaled_operator.h).
+  // APGD's passes run over the same fixed chunks (dem/linalg/scaled_operator.h).
   expect_same_state_on_any_number_of_threads(SolverParameters::Method::apgd);
 }

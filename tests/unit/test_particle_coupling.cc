@@ -5,7 +5,7 @@
 // the body must settle at its elastic thickness and stay there, and the energy of grains
 // and body must follow the work of the load, the contacts and the damping step by step.
 #include "coupling/particle_first_body.h"
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <Eigen/Eigenvalues>
 

@@ -3,8 +3,9 @@
 #include "app/case_parameters.h"
 #include "app/sample_file.h"
 #include "app/scene_hooks.h"
+#include "app/scenes.h"
 #include "core/parameter_file.h"
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include <deal.II/base/parameter_handler.h>
 

@@ -1,4 +1,4 @@
-#include "dem/solvers/scaled_operator.h"
+#include "dem/linalg/scaled_operator.h"
 
 #include <cmath>
 

@@ -65,7 +65,7 @@ namespace tribo::dem
 
   /// The operator A' + U'U'^T of a scaled frictionless problem (dimensionless: A' has a unit
   /// diagonal), row by row. A' is symmetric, so its column j, stored, is its row j; U' (n x k,
-  /// the walls' low-rank columns, dem/solvers/delassus.h) is kept by rows so that its part of a
+  /// the walls' low-rank columns, dem/linalg/delassus.h) is kept by rows so that its part of a
   /// product costs O(wall contacts), not O(n k).
   class ScaledOperator
   {

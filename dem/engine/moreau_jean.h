@@ -16,13 +16,13 @@
 #include "dem/solvers/active_set.h"
 #include "dem/solvers/apgd.h"
 #include "dem/solvers/apgs.h"
-#include "dem/boundary.h"
-#include "dem/contact.h"
-#include "dem/contact_law.h"
+#include "dem/engine/boundary.h"
+#include "dem/engine/contact.h"
+#include "dem/laws/contact_law.h"
 #include "dem/solvers/interior_point.h"
 #include "dem/solvers/mprgp.h"
 #include "dem/solvers/nlgs.h"
-#include "dem/particle_system.h"
+#include "dem/engine/particle_system.h"
 
 #include <Eigen/Core>
 
@@ -108,7 +108,7 @@ namespace tribo::dem
 
     /// Couple @p body (not owned; it must outlive this) to the discs through half-disc
     /// elements of diameter @p half_disc_diameter (m) facing @p outward, periodic with
-    /// the system's period (dem/boundary.h). Its loads, energy and power join the step's.
+    /// the system's period (dem/engine/boundary.h). Its loads, energy and power join the step's.
     void attach(BoundaryBody &body, double half_disc_diameter, const Vec2 &outward, double period);
 
     /// Advance @p system (and the attached boundary body) by one step @p h (s).
@@ -131,7 +131,7 @@ namespace tribo::dem
     double theta() const { return th; }
     double detection_distance() const { return distance; }
     /// Steps of motion at the start velocity over which a pair beyond the detection
-    /// distance is still a contact when it closes (dem/contact.h ContactDetector::detect):
+    /// distance is still a contact when it closes (dem/engine/contact.h ContactDetector::detect):
     /// the discs move h v_end before the next detection, and the margin covers an end
     /// velocity up to twice the start one.
     static constexpr double lookahead = 2;

@@ -2,7 +2,7 @@
 /// application names (ContactLaw::declare(), parse()).
 
 #include "core/parameter_file.h"
-#include "dem/contact_law.h"
+#include "dem/laws/contact_law.h"
 
 #include <deal.II/base/parameter_handler.h>
 

@@ -1,4 +1,4 @@
-#include "dem/particle_system.h"
+#include "dem/engine/particle_system.h"
 
 #include "core/errors.h"
 

@@ -1,7 +1,7 @@
-#include "dem/solvers/bisected_cholesky.h"
+#include "dem/linalg/bisected_cholesky.h"
 
-#include "dem/solvers/delassus.h"
-#include "dem/body_state.h"
+#include "dem/linalg/delassus.h"
+#include "dem/engine/body_state.h"
 
 #include <deal.II/base/parallel.h>
 

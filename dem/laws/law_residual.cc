@@ -1,6 +1,6 @@
-#include "dem/law_residual.h"
+#include "dem/laws/law_residual.h"
 
-#include "dem/body_state.h"
+#include "dem/engine/body_state.h"
 
 #include <algorithm>
 #include <cmath>

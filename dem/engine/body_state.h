@@ -3,8 +3,8 @@
 /// local velocity of a contact (u = H^T v), the application of an impulse (v += M^-1 H dr)
 /// and a contact's own Delassus block.
 
-#include "dem/contact.h"
-#include "dem/particle_system.h"
+#include "dem/engine/contact.h"
+#include "dem/engine/particle_system.h"
 
 #include <Eigen/Core>
 
@@ -20,7 +20,7 @@ namespace tribo::dem
     std::vector<Eigen::Vector3d>       velocity;
     std::vector<std::array<double, 3>> inverse_mass;
     /// Velocities of the boundary nodes of a BoundaryBody (2n: x, y per node), m/s,
-    /// and its compliance (dem/boundary.h); empty / null without one.
+    /// and its compliance (dem/engine/boundary.h); empty / null without one.
     Eigen::VectorXd        node_velocity;
     const Eigen::MatrixXd *node_compliance = nullptr;
 
@@ -67,7 +67,7 @@ namespace tribo::dem
 
     /// The own Delassus block of @p c, sum over its two bodies of H^T M^-1 H (for a
     /// half-disc contact: the grain's part plus B^T G_AB B, with B the 4x2 map from
-    /// (r_n, r_t) to the impulses -J_A^T f, -J_B^T f on its two nodes, dem/boundary.h).
+    /// (r_n, r_t) to the impulses -J_A^T f, -J_B^T f on its two nodes, dem/engine/boundary.h).
     Eigen::Matrix2d delassus_block(const Contact &c) const;
 
     /// Side 0 of a half-disc contact: velocity of the half-disc's material point at the

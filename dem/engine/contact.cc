@@ -1,4 +1,4 @@
-#include "dem/contact.h"
+#include "dem/engine/contact.h"
 
 #include "core/errors.h"
 

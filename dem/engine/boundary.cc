@@ -1,7 +1,7 @@
-#include "dem/boundary.h"
+#include "dem/engine/boundary.h"
 
 #include "core/errors.h"
-#include "dem/contact.h"
+#include "dem/engine/contact.h"
 
 #include <algorithm>
 #include <cmath>
@@ -187,7 +187,7 @@ namespace tribo::dem
               ct.branch = branch;
               ct.gap    = gap;
               // The half-disc's material point at the contact point: the centre's
-              // interpolation plus the edge's rotation (dem/boundary.h).
+              // interpolation plus the edge's rotation (dem/engine/boundary.h).
               const Vec2            a  = (rho + 0.5 * gap) * ct.normal;
               const Eigen::Matrix2d turn = perp(a) * e_perp.transpose() / p.edge.squaredNorm();
               const double          xi = anchor_xi[k];

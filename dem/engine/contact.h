@@ -1,7 +1,7 @@
 #pragma once
 /// @file Contacts between discs of different bodies and their detection.
 
-#include "dem/particle_system.h"
+#include "dem/engine/particle_system.h"
 
 #include <Eigen/Core>
 
@@ -27,11 +27,11 @@ namespace tribo::dem
     Eigen::Vector2d r      = Eigen::Vector2d::Zero(); ///< impulse, N s/m
     Eigen::Vector2d u_free = Eigen::Vector2d::Zero(); ///< local velocity of the free motion (no impulses), m/s
     double cohesion_impulse = 0, shift = 0, compliance = 0; ///< law terms (ContactLaw::Terms)
-    /// Against a half-disc element of a BoundaryBody (dem/boundary.h): its index, else -1.
+    /// Against a half-disc element of a BoundaryBody (dem/engine/boundary.h): its index, else -1.
     /// Side 0 is then the half-disc, a rigid body carried by the chain edge that holds
     /// its anchor (nodes node[0] = A, node[1] = B). The velocity of its material point at
     /// the contact point is v_P = J_A v_A + J_B v_B with J = node_map (2x2, the centre's
-    /// interpolation plus the edge's rotation, dem/boundary.h); an impulse r on the grain
+    /// interpolation plus the edge's rotation, dem/engine/boundary.h); an impulse r on the grain
     /// puts -J_A^T f and -J_B^T f (f = r_n n + r_t t) on the nodes. body[0] and the
     /// side-0 arms are unused.
     int             half_disc = -1;

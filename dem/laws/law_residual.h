@@ -16,8 +16,8 @@
 /// The gap violation is theta h max(0, -(u_n + b)) over the IQS contacts (m): how far the
 /// end-of-step gap is left below what the law allows.
 
-#include "dem/contact.h"
-#include "dem/contact_law.h"
+#include "dem/engine/contact.h"
+#include "dem/laws/contact_law.h"
 
 #include <vector>
 

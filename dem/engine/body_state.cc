@@ -1,4 +1,4 @@
-#include "dem/body_state.h"
+#include "dem/engine/body_state.h"
 
 namespace tribo::dem
 {

@@ -40,7 +40,7 @@
 /// one contact reach wide: every half-disc within reach of a grain is tested, however
 /// far the face has moved from its reference position.
 
-#include "dem/particle_system.h"
+#include "dem/engine/particle_system.h"
 
 #include <Eigen/Core>
 

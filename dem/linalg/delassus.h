@@ -8,7 +8,7 @@
 /// local frame of i, s_ib = -1 for side 0 and +1 for side 1, M_b^-1 the inverse masses
 /// (0 for imposed dofs), and for half-disc contacts B_i the 4x2 map from (r_n, r_t) to the
 /// impulses -J_A^T f, -J_B^T f on the edge's two nodes, G_AB the boundary body's
-/// compliance between those nodes (dem/boundary.h). Units: m/s per N s/m. Periodic
+/// compliance between those nodes (dem/engine/boundary.h). Units: m/s per N s/m. Periodic
 /// contacts need nothing special: their arms already use the periodic image.
 /// W_ii is the contact's own block (BodyState::delassus_block).
 ///

@@ -1,7 +1,7 @@
-#include "dem/solvers/delassus.h"
+#include "dem/linalg/delassus.h"
 
-#include "dem/contact.h"
-#include "dem/body_state.h"
+#include "dem/engine/contact.h"
+#include "dem/engine/body_state.h"
 
 #include <Eigen/Dense>
 

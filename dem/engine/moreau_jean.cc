@@ -1,7 +1,7 @@
-#include "dem/moreau_jean.h"
+#include "dem/engine/moreau_jean.h"
 
 #include "core/errors.h"
-#include "dem/law_residual.h"
+#include "dem/laws/law_residual.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
