@@ -1,7 +1,7 @@
 #include "core/checkpoint.h"
 
 #include "core/errors.h"
-#include "core/output.h"
+#include "core/atomic_file.h"
 
 #include <boost/archive/archive_exception.hpp>
 #include <boost/archive/binary_iarchive.hpp>

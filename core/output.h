@@ -4,6 +4,7 @@
 /// Every file is written to "NAME.tmp" and renamed, so a file that exists is
 /// complete as far as it goes (see docs/outputs.md).
 
+#include "core/atomic_file.h"
 #include "core/checkpoint.h"
 
 #include <cstdio>
@@ -16,9 +17,6 @@
 
 namespace tribo
 {
-  /// Write @p content to @p path atomically (temporary file, then rename).
-  void atomic_write(const std::string &path, const std::string &content);
-
   /// A table of named numeric columns, one row per output step.
   class TimeSeries
   {

@@ -1,7 +1,7 @@
 #pragma once
 /// @file The shear cell's upper first body, whatever its model, as the scene sees it: one
 /// interface (FirstBody) that the scene places, loads, measures, writes and checkpoints,
-/// and one table of models behind the Upper body model entry (coupling/first_body.cc).
+/// and one table of models behind the Upper body model entry (coupling/models.cc).
 ///
 /// Models, each a row of the table and a file of coupling/:
 /// - rigid (rigid_wall.cc): a rough wall of discs, a clump in the scene's particle system,

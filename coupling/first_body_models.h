@@ -1,6 +1,6 @@
 #pragma once
 /// @file What the scene asks of the upper first-body models without naming one: the
-/// table behind the Upper body model entry (coupling/first_body.cc) seen from outside.
+/// table behind the Upper body model entry (coupling/models.cc) seen from outside.
 
 #include <string>
 #include <vector>

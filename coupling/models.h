@@ -1,6 +1,6 @@
 #pragma once
-/// @file The models behind the table of coupling/first_body.cc, one file each: what the
-/// table's rows point to. Only the table includes this.
+/// @file The models behind the table of coupling/models.cc, one file each: what the
+/// table's rows point to, declared once for the table and the model files.
 
 #include "coupling/deformable_body.h"
 #include "coupling/first_body.h"

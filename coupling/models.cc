@@ -1,3 +1,7 @@
+/// @file The table of the upper first-body models (the Upper body model entry) and what
+/// it serves: the entries every model reads, each model's check when the case is read,
+/// the factories, the chain nodes.
+
 #include "coupling/first_body.h"
 #include "coupling/first_body_models.h"
 #include "coupling/models.h"
