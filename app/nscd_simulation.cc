@@ -122,6 +122,7 @@ namespace tribo::app
         solver.gap_target            = p.solver.relative_gap_target * system.min_radius();
         mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
         scene->attach(*mj);
+        world.integrator = mj.get();
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
         // A run that goes on from an initial state starts at its step (a whole number of
         // steps, checked with the parameters).
@@ -171,9 +172,12 @@ namespace tribo::app
 
       void advance(unsigned long s, const std::function<void(const std::string &)> &warn) override
       {
-        scene->before_step(system, s);
+        world.step = s;
+        scene->before_step(world);
         const dem::StepReport r = mj->step(system, h);
         step                    = s + 1;
+        world.report            = r;
+        scene->after_step(world);
         record.add(r);
         timing.add(r);
         if (!r.solver.converged && ++record.non_converged <= 10)
@@ -216,7 +220,7 @@ namespace tribo::app
           ("gap_violation", r.solver.gap_violation)("epsilon", r.epsilon)("max_overlap", r.max_overlap)
           ("kinetic_energy", r.kinetic_energy)("power_external", r.power_external)
           ("power_free", r.power_free)("power_contacts", r.power_contacts);
-        scene->measure(system, *mj, r, last);
+        scene->measure(world, last);
         measured = true;
         const auto &columns = last.columns();
         power_sums.resize(columns.size(), 0.0);
@@ -325,7 +329,7 @@ namespace tribo::app
         summary.set("peak_memory", peak_memory_mb());
         if (!end.statistics.rows().empty())
           {
-            scene->summarize(system, end.statistics, out.results);
+            scene->summarize(world, end.statistics, out.results);
             if (const std::string note = scene->averaging_note(); !note.empty())
               end.log(note);
           }
@@ -380,6 +384,7 @@ namespace tribo::app
       CaseParameters                   prm;
       std::unique_ptr<Scene>           scene;
       dem::ParticleSystem              system;
+      NscdWorld                        world{system}; ///< what the scene's hooks see
       std::unique_ptr<dem::MoreauJean> mj;
       double                           h = 0;
       unsigned long                    n_steps = 0, start = 0, step = 0;

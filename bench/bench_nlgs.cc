@@ -69,10 +69,12 @@ int main(int argc, char **argv)
   dem::MoreauJean mj(p.theta, p.law, p.solver, p.law.detection_distance > 0 ? p.law.detection_distance : 0.1 * system.min_radius());
 
   std::printf("case %s: %zu discs, h = %g s\n", case_file.c_str(), system.discs.size(), h);
+  app::NscdWorld world{system};
   auto t0 = Clock::now();
   for (unsigned s = 0; s < compact_steps; ++s)
     {
-      scene->before_step(system, s);
+      world.step = s;
+      scene->before_step(world);
       mj.step(system, h);
     }
   std::printf("compaction: %u steps in %.2f s\n", compact_steps, seconds_since(t0));
@@ -84,7 +86,8 @@ int main(int argc, char **argv)
   t0 = Clock::now();
   for (unsigned s = 0; s < timed_steps; ++s)
     {
-      scene->before_step(system, compact_steps + s);
+      world.step = compact_steps + s;
+      scene->before_step(world);
       const auto r = mj.step(system, h);
       sweeps += r.solver.iterations;
       contacts += r.n_contacts;

@@ -84,9 +84,10 @@ namespace tribo::app
         return prm.time_step;
       }
 
-      void measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj, const dem::StepReport &,
-                   Row &row) override
+      void measure(const NscdWorld &w, Row &row) override
       {
+        const auto &s  = w.system;
+        const auto &mj = *w.integrator;
         const double gap = (s.bodies[1].position - s.bodies[0].position).norm() -
                            s.discs[0].radius - s.discs[1].radius;
         const double vrel = s.bodies[1].velocity.x() - s.bodies[0].velocity.x();
@@ -110,8 +111,9 @@ namespace tribo::app
 
       bool finished() const override { return collision.stop_when_separated && separated; }
 
-      void summarize(const dem::ParticleSystem &s, const TimeSeries &, JsonObject &j) override
+      void summarize(const NscdWorld &w, const TimeSeries &, JsonObject &j) override
       {
+        const auto &s = w.system;
         const double dt_star = std::sqrt(m_eff / prm.law.stiffness);
         const double v_in    = collision.impact_velocity;
         const double v_out   = s.bodies[1].velocity.x() - s.bodies[0].velocity.x();

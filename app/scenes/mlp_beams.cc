@@ -108,8 +108,10 @@ namespace tribo::app
           }
       }
 
-      void after_step(Particles &p, double, double dt) override
+      void after_step(MlpWorld &w) override
       {
+        Particles   &p  = w.particles;
+        const double dt = w.dt;
         // Mean x displacement of each beam, by integrating its mean velocity (the
         // positions wrap along x).
         double v[2] = {0, 0};
@@ -119,9 +121,12 @@ namespace tribo::app
           displacement[b] += dt * v[b] / (nx * ny);
       }
 
-      void measure(const Particles &p, const mlp::Box &box, const mlp::ForceField &field, double t,
-                   Row &row) override
+      void measure(const MlpWorld &w, Row &row) override
       {
+        const Particles       &p     = w.particles;
+        const mlp::Box        &box   = w.box;
+        const mlp::ForceField &field = *w.field;
+        const double           t     = w.time;
         if (t >= start)
           sample_profile(p, box, field);
         row("transverse_traction", forcing)("slip", displacement[0] - displacement[1])
@@ -192,9 +197,9 @@ namespace tribo::app
         return batch_standard_error(ratio);
       }
 
-      void finish(const Particles &, const mlp::Box &, const mlp::ForceField &, const TimeSeries &stats,
-                  double, JsonObject &results, std::map<std::string, TimeSeries> &tables) override
+      void summarize(const MlpWorld &, const TimeSeries &stats, JsonObject &results) override
       {
+        auto &tables = made_tables;
         TimeSeries profile({"y", "y_from_contact", "f_return_net", "f_return_bond", "n_samples"});
         for (unsigned int b = 0; b < bins; ++b)
           profile.add_row({(b + 0.5) * layer, (b + 0.5) * layer - contact_y,

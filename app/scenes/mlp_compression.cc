@@ -141,7 +141,7 @@ namespace tribo::app
         return hi - lo;
       }
 
-      void before_step(Particles &p, double t, double dt) override { kick_platens(p, t, dt); }
+      void before_step(MlpWorld &w) override { kick_platens(w.particles, w.time, w.dt); }
 
       /// Platen distance over its initial value.
       double platen_ratio(const Particles &p) const
@@ -151,8 +151,10 @@ namespace tribo::app
 
       bool finished() const override { return stroke_end; }
 
-      void after_step(Particles &p, double t, double dt) override
+      void after_step(MlpWorld &w) override
       {
+        Particles   &p  = w.particles;
+        const double t = w.time, dt = w.dt;
         kick_platens(p, t, dt);
         stroke_end = platen_ratio(p) < stop_h;
         for (unsigned int k = 0; k < 2; ++k)
@@ -160,8 +162,10 @@ namespace tribo::app
             arrival[k] = t;
       }
 
-      void measure(const Particles &p, const mlp::Box &, const mlp::ForceField &, double t, Row &row) override
+      void measure(const MlpWorld &w, Row &row) override
       {
+        const Particles &p = w.particles;
+        const double     t = w.time;
         if (next_map < map_times.size() && t >= map_times[next_map] - 1e-15)
           {
             density_snapshot(p, t);
@@ -214,10 +218,11 @@ namespace tribo::app
         ++map_count;
       }
 
-      void finish(const Particles &p, const mlp::Box &, const mlp::ForceField &,
-                  const TimeSeries &stats, double t, JsonObject &results,
-                  std::map<std::string, TimeSeries> &tables) override
+      void summarize(const MlpWorld &w, const TimeSeries &stats, JsonObject &results) override
       {
+        const Particles &p      = w.particles;
+        const double     t      = w.time;
+        auto            &tables = made_tables;
         if (map_count < maps)
           density_snapshot(p, t); // the last map at the final time, if the run stopped early
         const auto   dh    = stats.column("delta_h");

@@ -207,6 +207,7 @@ namespace tribo::app::mlp_scenes
         scene->build(particles, box);
         field = std::make_unique<mlp::ForceField>(s.interaction);
         field->set_parallel(false);
+        world.field = field.get();
         s.langevin = checked_step(file, *field, particles, s.langevin);
         scene->prepare(particles, box, *field, log);
         integrator = std::make_unique<mlp::LangevinIntegrator>(*field, particles, s.langevin);
@@ -243,12 +244,15 @@ namespace tribo::app::mlp_scenes
       void advance(unsigned long k, const std::function<void(const std::string &)> &) override
       {
         scene->set_loads(particles, (k + 1) * dt);
-        scene->before_step(particles, k * dt, dt);
+        world.time = k * dt;
+        world.dt   = dt;
+        scene->before_step(world);
         integrator->step(particles, box);
         step = k + 1;
         if (!box.periodic_x)
           check_bounded(particles, centre, bound, time());
-        scene->after_step(particles, time(), dt);
+        world.time = time();
+        scene->after_step(world);
       }
 
       bool row(Row &row) override
@@ -256,7 +260,8 @@ namespace tribo::app::mlp_scenes
         const double ke = particles.kinetic_energy();
         row("kinetic_energy", ke)("kinetic_temperature", ke / particles.size())
           ("n_pairs", double(field->neighbours().pairs().size()));
-        scene->measure(particles, box, *field, time(), row);
+        world.time = time();
+        scene->measure(world, row);
         return true;
       }
       bool row_at_start() const override { return true; }
@@ -283,7 +288,9 @@ namespace tribo::app::mlp_scenes
 
       void summarize(const RunEnd &end, JsonObject &summary, RunOutputs &out) override
       {
-        scene->finish(particles, box, *field, end.statistics, time(), out.results, out.tables);
+        world.time = time();
+        scene->summarize(world, end.statistics, out.results);
+        out.tables = scene->tables();
         summary.set("time_step", dt);
         summary.set("stable_time_step_limit", integrator->max_time_step());
         summary.set("steps_planned", long(n_steps));
@@ -320,6 +327,7 @@ namespace tribo::app::mlp_scenes
       std::string                              scene_name;
       Particles                                particles;
       mlp::Box                                 box;
+      MlpWorld                                 world{particles, box}; ///< what the scene's hooks see
       std::unique_ptr<MlpScene>                scene;
       std::unique_ptr<mlp::ForceField>         field;
       std::unique_ptr<mlp::LangevinIntegrator> integrator;

@@ -9,6 +9,7 @@
 /// energies J/m). x is the axis of the loads (left-right), y the transverse axis.
 
 #include "app/driver.h"
+#include "app/scene_of.h"
 #include "app/scene_hooks.h"
 #include "core/parameter_file.h"
 #include "mlp/interaction.h"
@@ -68,35 +69,35 @@ namespace tribo::app::mlp_scenes
   /// Square along an axis: E = C11 - C12^2/C11 = k_c, c_L = sqrt(k_c/rho).
   std::pair<double, double> axial_theory(const CommonSettings &s);
 
-  /// What an MLP scene adds to the family's Simulation, its part of the time loop.
-  class MlpScene
+  /// What the MLP family's hooks see (app/scene_of.h): the particles, the box, the force
+  /// field and the time.
+  struct MlpWorld
+  {
+    Particles             &particles;
+    mlp::Box              &box;
+    const mlp::ForceField *field = nullptr; ///< null until built
+    /// s: the step's start in before_step(), its end in after_step(), the row's time in
+    /// measure(), the end in summarize().
+    double time = 0;
+    double dt   = 0; ///< the step, s
+  };
+
+  /// An MLP scene: the one scene interface on the particles, plus building them, their
+  /// preparation and the loads.
+  class MlpScene : public SceneOf<MlpWorld>
   {
   public:
-    virtual ~MlpScene() = default;
     /// Places the particles and sets the box.
     virtual void build(Particles &p, mlp::Box &box) = 0;
     /// Called once the force field exists, before the first step (e.g. relaxation).
     virtual void prepare(Particles &, const mlp::Box &, mlp::ForceField &, Log &) {}
     /// Sets the external forces for time @p t (s), before the step that ends at t.
     virtual void set_loads(Particles &, double /*t*/) {}
-    /// Before the step from @p t to t + @p dt (s), after set_loads(t + dt).
-    virtual void before_step(Particles &, double /*t*/, double /*dt*/) {}
-    /// After every step, at time @p t (s): per-step updates and measurements.
-    virtual void after_step(Particles &, double /*t*/, double /*dt*/) {}
-    /// True when the scene has reached its own end (the run stops, complete).
-    virtual bool finished() const { return false; }
-    /// The scene's statistics columns at time @p t as (name, value) pairs (measurements
-    /// due at t are taken here: a row is due).
-    virtual void measure(const Particles &p, const mlp::Box &box, const mlp::ForceField &field, double t,
-                         Row &row) = 0;
-    /// Scene results (summary.json "results") and tables (CSV and results.h5 groups).
-    virtual void finish(const Particles &p, const mlp::Box &box, const mlp::ForceField &field,
-                        const TimeSeries &stats, double t, JsonObject &results,
-                        std::map<std::string, TimeSeries> &tables) = 0;
-    /// Checkpoint: what the scene carries from step to step (loads, accumulators, tables
-    /// so far); what build() makes is rebuilt with the scene. Default: nothing.
-    virtual void save(CheckpointOut &) const {}
-    virtual void load(CheckpointIn &) {}
+    std::map<std::string, TimeSeries> tables() const override { return made_tables; }
+
+  protected:
+    /// The tables summarize() made (CSV and results.h5 groups).
+    std::map<std::string, TimeSeries> made_tables;
   };
 
   /// Reads a scene's own subsection and makes the scene.

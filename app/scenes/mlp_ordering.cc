@@ -65,8 +65,9 @@ namespace tribo::app
             std::to_string(relaxation) + " capped relaxation iterations");
       }
 
-      void measure(const Particles &p, const mlp::Box &, const mlp::ForceField &, double, Row &row) override
+      void measure(const MlpWorld &w, Row &row) override
       {
+        const Particles &p = w.particles;
         row("extent_x", mlp::extent(p, 0))("extent_y", mlp::extent(p, 1));
       }
 
@@ -77,10 +78,12 @@ namespace tribo::app
         return s.lattice == mlp::LatticeType::hexagonal ? 4 * M_PI / (std::sqrt(3.0) * c) : 2 * M_PI / c;
       }
 
-      void finish(const Particles &p, const mlp::Box &box, const mlp::ForceField &field,
-                  const TimeSeries &, double, JsonObject &results,
-                  std::map<std::string, TimeSeries> &tables) override
+      void summarize(const MlpWorld &w, const TimeSeries &, JsonObject &results) override
       {
+        const Particles       &p      = w.particles;
+        const mlp::Box        &box    = w.box;
+        const mlp::ForceField &field  = *w.field;
+        auto                  &tables = made_tables;
         const double q_b = bragg();
         const auto   S   = mlp::structure_factor(p, q_range * q_b, grid);
         TimeSeries   table({"qx", "qy", "S"});

@@ -274,8 +274,10 @@ namespace tribo::app
           k.layer_thickness > 0 ? k.layer_thickness : k.sample.empty() ? k.mean_diameter : mean_grain_diameter);
       }
 
-      void before_step(dem::ParticleSystem &s, unsigned long step) override
+      void before_step(NscdWorld &w) override
       {
+        auto        &s    = w.system;
+        const auto   step = w.step;
         const auto  &k    = cell;
         const double t    = step * prm.time_step;
         const double t_load = upper_body->load_time(t, cell.start_time);
@@ -306,9 +308,11 @@ namespace tribo::app
         return upper_body->write_fields(dir, index);
       }
 
-      void measure(const dem::ParticleSystem &s, const dem::MoreauJean &mj, const dem::StepReport &r,
-                   Row &row) override
+      void measure(const NscdWorld &w, Row &row) override
       {
+        const auto &s  = w.system;
+        const auto &mj = *w.integrator;
+        const auto &r  = w.report;
         ++steps_done;
         const double t     = steps_done * prm.time_step;
         const auto  &f     = mj.contact_force();
@@ -360,7 +364,7 @@ namespace tribo::app
           ("upper_body_face_shift", upper_body->face_shift());
       }
 
-      void summarize(const dem::ParticleSystem &, const TimeSeries &stats, JsonObject &j) override
+      void summarize(const NscdWorld &, const TimeSeries &stats, JsonObject &j) override
       {
         const auto  &k     = cell;
         const auto   time  = stats.column("time");

@@ -154,6 +154,7 @@ namespace tribo::app::sph_scenes
         : ls(settings)
         , solver(std::move(s))
         , exp(make_experiment(*solver))
+        , world{*solver}
         , next_row(ls.statistics_interval)
         , next_field(ls.field_interval > 0 ? ls.field_interval : 2 * ls.end_time)
       {}
@@ -164,17 +165,18 @@ namespace tribo::app::sph_scenes
 
       void advance(unsigned long, const std::function<void(const std::string &)> &) override
       {
-        exp->before_step(*solver);
-        dt    = solver->step(std::min(ls.end_time - solver->time, exp->step_limit(*solver)));
-        dt_lo = std::min(dt_lo, dt);
-        dt_hi = std::max(dt_hi, dt);
-        exp->after_step(*solver, dt);
+        exp->before_step(world);
+        dt       = solver->step(std::min(ls.end_time - solver->time, exp->step_limit(*solver)));
+        dt_lo    = std::min(dt_lo, dt);
+        dt_hi    = std::max(dt_hi, dt);
+        world.dt = dt;
+        exp->after_step(world);
       }
 
       bool row(Row &row) override
       {
         row("dt", dt);
-        exp->row(*solver, row);
+        exp->measure(world, row);
         return true;
       }
       bool row_at_start() const override { return true; }
@@ -207,7 +209,8 @@ namespace tribo::app::sph_scenes
         summary.set("dt_max", dt_hi);
         summary.set("last_step_limiter", solver->last_limiter());
         summary.set("n_particles", long(solver->state.size()));
-        exp->summarize(end.statistics, solver->time, out.results);
+        exp->summarize(world, end.statistics, out.results);
+        out.tables = exp->tables();
         out.scalars["dt_min"] = end.step ? dt_lo : 0.0;
         out.scalars["dt_max"] = dt_hi;
         std::ostringstream os;
@@ -247,6 +250,7 @@ namespace tribo::app::sph_scenes
       LoopSettings                      ls;
       std::unique_ptr<sph::Solver<dim>> solver;
       std::unique_ptr<Experiment<dim>>  exp;
+      SphWorld<dim>                     world; ///< what the experiment's hooks see
       double dt = 0, dt_lo = std::numeric_limits<double>::infinity(), dt_hi = 0, next_row, next_field;
     };
   } // namespace

@@ -1,13 +1,15 @@
 #pragma once
 /// @file The SPH scene family (sph_slider, sph_plate): what its scenes share. Each scene
-/// (app/scenes/sph_slider.cc, app/scenes/sph_plate.cc) is an Experiment<dim> that
-/// make_simulation() runs as the driver's Simulation: adaptive RK2 steps of the solver,
+/// (app/scenes/sph_slider.cc, app/scenes/sph_plate.cc) is an Experiment<dim>, the one scene
+/// interface on the solver, that make_simulation() runs as the driver's Simulation:
+/// adaptive RK2 steps of the solver,
 /// statistics rows and VTU snapshots on intervals of simulated time.
 ///
 /// SI units. The vertical axis is the last one (y in 2D, z in 3D); in 2D (plane strain)
 /// forces are per metre of depth (N/m) and masses kg/m.
 
 #include "app/driver.h"
+#include "app/scene_of.h"
 #include "core/parameter_file.h"
 #include "sph/eos.h"
 #include "sph/solver.h"
@@ -70,30 +72,25 @@ namespace tribo::app::sph_scenes
   /// parameters (the others at their defaults); InputError naming the entry.
   sph::SolverParameters read_integration(EntryReader &r, const std::string &section);
 
-  /// What an SPH scene adds to the family's Simulation, its part of the time loop: its
-  /// step limit, its per-step bookkeeping, its rows and its summary.
+  /// What the SPH family's hooks see (app/scene_of.h): the solver, and after a step its
+  /// length.
   template <int dim>
-  class Experiment
+  struct SphWorld
+  {
+    sph::Solver<dim> &solver;
+    double            dt = 0; ///< the last step's length, s
+  };
+
+  /// An SPH scene: the one scene interface on the SPH solver, plus its step limit and the
+  /// sizes of its groups.
+  template <int dim>
+  class Experiment : public SceneOf<SphWorld<dim>>
   {
   public:
-    virtual ~Experiment() = default;
     /// Largest step allowed now (to land on an event time), s.
     virtual double step_limit(const sph::Solver<dim> &) const { return std::numeric_limits<double>::infinity(); }
-    /// Before each step (state at the start of the step).
-    virtual void before_step(sph::Solver<dim> &solver) = 0;
-    /// After a step of length @p dt.
-    virtual void after_step(sph::Solver<dim> &solver, double dt) = 0;
-    /// The scene's columns of a statistics row (after "time", "step", "dt") as (name,
-    /// value) pairs; resets the interval averages.
-    virtual void row(const sph::Solver<dim> &solver, Row &row) = 0;
     /// Integer entries of summary.json that come first (the sizes of the scene's groups).
     virtual std::vector<std::pair<std::string, long>> counts() const { return {}; }
-    /// Results of the run for summary.json "results" from the statistics.
-    virtual void summarize(const TimeSeries &stats, double t_end, JsonObject &results) const = 0;
-    /// Checkpoint: what the scene carries from step to step (its accumulators and phase);
-    /// its groups of particles are rebuilt with it.
-    virtual void save(CheckpointOut &ar) const = 0;
-    virtual void load(CheckpointIn &ar)        = 0;
   };
 
   /// Output settings of the explicit loop.

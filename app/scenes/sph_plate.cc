@@ -110,12 +110,11 @@ namespace tribo::app
         log(os.str());
       }
 
-      void before_step(sph::Solver<2> &) override {}
-
       /// Records the tip deflection (mean over the tip column, m) and velocity (m/s)
       /// at every step and finds the first zero crossings.
-      void after_step(sph::Solver<2> &solver, double) override
+      void after_step(SphWorld<2> &world) override
       {
+        const auto &solver = world.solver;
         double w = 0, v = 0;
         tip_state(solver, w, v);
         const double t = solver.time;
@@ -128,8 +127,9 @@ namespace tribo::app
         v_prev = v;
       }
 
-      void row(const sph::Solver<2> &solver, Row &row) override
+      void measure(const SphWorld<2> &world, Row &row) override
       {
+        const auto &solver = world.solver;
         double w = 0, v = 0;
         tip_state(solver, w, v);
         const double ke = solver.state.kinetic_energy(), ei = solver.state.internal_energy();
@@ -137,7 +137,7 @@ namespace tribo::app
           ("total_energy", ke + ei);
       }
 
-      void summarize(const TimeSeries &stats, double, JsonObject &res) const override
+      void summarize(const SphWorld<2> &, const TimeSeries &stats, JsonObject &res) override
       {
         const double measured = t_w0 > 0 ? M_PI / t_w0 : t_v0 > 0 ? M_PI / (2 * t_v0) : 0.0;
         res.set("omega_analytic", omega);

@@ -202,8 +202,9 @@ namespace tribo::app
       /// Starts sliding at the slide start; keeps the loaded layer's velocities and the
       /// block's positions at the start of the step (for the pressure's work, the drive
       /// and the unwrapped displacements).
-      void before_step(sph::Solver<dim> &solver) override
+      void before_step(SphWorld<dim> &world) override
       {
+        auto &solver = world.solver;
         if (!sliding && solver.time >= p.slide_start * (1 - 1e-12))
           start_sliding(solver);
         if (sliding && drive < 0)
@@ -220,8 +221,10 @@ namespace tribo::app
       /// driven particles supplied: at every Runge-Kutta stage, or as the reset after the
       /// step with Drive = reset) and its work, V times it;
       /// interval sums of the contact forces (midpoint rates) weighted by dt.
-      void after_step(sph::Solver<dim> &solver, double dt) override
+      void after_step(SphWorld<dim> &world) override
       {
+        auto        &solver = world.solver;
+        const double dt     = world.dt;
         auto        &s    = solver.state;
         const double ramp = 1 - std::exp(-(solver.time - 0.5 * dt) / p.tau);
         for (unsigned int q = 0; q < top.size(); ++q)
@@ -248,8 +251,9 @@ namespace tribo::app
 
       /// The slider's columns (see columns()): interval means of the contact forces and
       /// the drive, centre-of-mass motion, energies; resets the interval sums.
-      void row(const sph::Solver<dim> &solver, Row &row) override
+      void measure(const SphWorld<dim> &world, Row &row) override
       {
+        const auto &solver = world.solver;
         const auto &s = solver.state;
         double      fx = 0, fn = 0;
         for (unsigned int r = 0; r < p.regions; ++r)
@@ -300,8 +304,9 @@ namespace tribo::app
       /// interval means over equal times), mu_std the standard deviation of the rows' mu,
       /// mu_stderr the standard error of mu_mean from batch means, each batch a whole lattice
       /// period when the window holds 3 or more (mu_stderr_batches says which).
-      void summarize(const TimeSeries &stats, double t_end, JsonObject &res) const override
+      void summarize(const SphWorld<dim> &world, const TimeSeries &stats, JsonObject &res) override
       {
+        const double t_end = world.solver.time;
         const auto   t       = stats.column("time");
         const double sliding = std::max(0.0, t_end - p.slide_start);
         const double period  = p.velocity > 0 ? p.spacing / p.velocity : 0.0;

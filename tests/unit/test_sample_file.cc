@@ -46,9 +46,11 @@ TEST(SampleFile, AFinalStateReadBackStartsTheSameBodies)
   // A sheared state: grains moving and spinning, the lower wall displaced along x.
   Cell first({"Shear cell/Shear start=0", "Shear cell/Pressure ramp time=0"});
   dem::MoreauJean mj(0.5, first.p.law, first.p.solver, 0.1 * first.system.min_radius());
+  app::NscdWorld world{first.system};
   for (unsigned long step = 0; step < 400; ++step)
     {
-      first.scene->before_step(first.system, step);
+      world.step = step;
+      first.scene->before_step(world);
       mj.step(first.system, first.p.time_step);
     }
   const std::string text = first.scene->sample(first.system);
