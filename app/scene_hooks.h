@@ -15,12 +15,23 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace tribo::app
 {
   struct CaseParameters; // app/case_parameters.h
+
+  /// A case of a study as a scene's compaction_of() hook sees it (app/study.cc).
+  struct StudyCase
+  {
+    std::vector<std::string> overrides; ///< "Subsection/Entry=value", over the study's base case
+    std::vector<std::string> entries;   ///< the entry of each override
+    /// The value of entry @p entry of the base case with the overrides @p overrides.
+    std::function<std::string(const std::vector<std::string> &overrides, const std::string &entry)> value;
+  };
 
   /// What a scene of this build gives the table: its subsections, its check, its factory.
   struct SceneHooks
@@ -38,6 +49,13 @@ namespace tribo::app
     /// path, as an absolute one), so that parameters.prm means the same from any
     /// directory (a resumed run, a run started from it elsewhere); nullptr: none.
     void (*resolve)(ParameterFile &) = nullptr;
+    /// A study's shared compaction: the overrides of the compaction-only run that the case
+    /// @p c can start from (its overrides that act before the shear, less the study's
+    /// @p shear_phase entries, and the run's end), or none when it cannot start from one
+    /// (a state of its own, no compaction, a body the state cannot hold). nullptr: the
+    /// scene has no compaction to share.
+    std::vector<std::string> (*compaction_of)(const StudyCase &c, const std::vector<std::string> &shear_phase) =
+      nullptr;
   };
 
   SceneHooks collision_hooks(); ///< app/scenes/collision.cc, subsection "Collision"

@@ -6,7 +6,6 @@
 #include "core/output.h"
 #include "core/parameter_file.h"
 #include "core/run_control.h"
-#include "coupling/first_body_models.h"
 
 #include <deal.II/base/mpi.h>
 
@@ -92,16 +91,6 @@ namespace tribo::app
     /// The entry of an override "Subsection/Entry=value".
     std::string entry_of(const std::string &assignment) { return trim(assignment.substr(0, assignment.find('='))); }
 
-    /// True for the entries that act only from Shear cell/Shear start on, or not on the
-    /// bodies at all: the cases of a study that differ only in these (and in the study's
-    /// Shear-phase entries) share one compaction.
-    bool acts_only_after_shear_start(const std::string &entry)
-    {
-      return entry == "Simulation/End time" || entry == "Shear cell/Sliding velocity" ||
-             entry == "Shear cell/Profile samples" || entry == "Shear cell/Layer thickness" ||
-             entry.rfind("Output/", 0) == 0;
-    }
-
     /// The case file @p base with @p overrides, resolved.
     std::unique_ptr<ParameterFile> resolved_case(dealii::ParameterHandler &prm, const fs::path &base,
                                                  const std::vector<std::string> &overrides)
@@ -114,31 +103,31 @@ namespace tribo::app
       return file;
     }
 
-    /// The compaction a shear case of @p base with @p overrides starts from, as the
-    /// overrides of a compaction-only run (its entries that act before Shear start, End
-    /// time = Shear start); "" when the case cannot share one (another scene, a state of
-    /// its own, no compaction or no shearing, or a compaction with a deformable upper body:
-    /// a state holds discs only).
+    /// The compaction the case of @p base with @p overrides starts from, as the overrides
+    /// of a compaction-only run: its scene's answer (SceneHooks::compaction_of), none for a
+    /// scene without one.
     std::vector<std::string> preparation_of(const fs::path &base, const std::vector<std::string> &overrides,
                                             const std::vector<std::string> &shear_phase)
     {
-      dealii::ParameterHandler prm;
-      const auto               file = resolved_case(prm, base, overrides);
-      if (file->get("Simulation/Scene") != "shear" || !file->get("Shear cell/Initial state").empty() ||
-          file->get_double("Shear cell/Shear start") <= 0 ||
-          file->get_double("Shear cell/Shear start") >= file->get_double("Simulation/End time"))
-        return {};
-      std::vector<std::string> preparation;
+      struct Resolved
+      {
+        dealii::ParameterHandler       prm;
+        std::unique_ptr<ParameterFile> file;
+      };
+      std::map<std::vector<std::string>, std::unique_ptr<Resolved>> resolved;
+      StudyCase c{overrides, {}, [&](const std::vector<std::string> &o, const std::string &entry) {
+                    auto &r = resolved[o];
+                    if (!r)
+                      {
+                        r       = std::make_unique<Resolved>();
+                        r->file = resolved_case(r->prm, base, o);
+                      }
+                    return r->file->get(entry);
+                  }};
       for (const auto &o : overrides)
-        if (!acts_only_after_shear_start(entry_of(o)) &&
-            std::find(shear_phase.begin(), shear_phase.end(), entry_of(o)) == shear_phase.end())
-          preparation.push_back(o);
-      preparation.push_back("Simulation/End time=" + file->get("Shear cell/Shear start"));
-      preparation.push_back("Output/Plots=false");
-      dealii::ParameterHandler prepared;
-      if (!coupling::is_wall_of_discs(resolved_case(prepared, base, preparation)->get("Shear cell/Upper body model")))
-        return {};
-      return preparation;
+        c.entries.push_back(entry_of(o));
+      const auto &hooks = scene_named(c.value(overrides, "Simulation/Scene")).hooks;
+      return hooks.compaction_of ? hooks.compaction_of(c, shear_phase) : std::vector<std::string>{};
     }
 
     /// Number @p v with @p digits significant digits (v itself if it is not wholly a number).

@@ -19,6 +19,7 @@
 #include "core/errors.h"
 
 #include "coupling/first_body.h"
+#include "coupling/first_body_models.h"
 
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
@@ -727,6 +728,42 @@ namespace tribo::app
     };
   } // namespace
 
+  namespace
+  {
+    /// True for the entries that act only from Shear cell/Shear start on, or not on the
+    /// bodies at all: the cases of a study that differ only in these (and in the study's
+    /// Shear-phase entries) share one compaction.
+    bool acts_only_after_shear_start(const std::string &entry)
+    {
+      return entry == "Simulation/End time" || entry == "Shear cell/Sliding velocity" ||
+             entry == "Shear cell/Profile samples" || entry == "Shear cell/Layer thickness" ||
+             entry.rfind("Output/", 0) == 0;
+    }
+
+    /// The compaction a shear case starts from (SceneHooks::compaction_of): its overrides
+    /// that act before Shear start, End time = Shear start; none for a case with a state of
+    /// its own, no compaction or no shearing, or a compaction with a body that is not a wall
+    /// of discs (a state holds discs only).
+    std::vector<std::string> compaction_of(const StudyCase &c, const std::vector<std::string> &shear_phase)
+    {
+      const auto   value = [&](const std::string &entry) { return c.value(c.overrides, entry); };
+      const double start = std::stod(value("Shear cell/Shear start"));
+      if (!value("Shear cell/Initial state").empty() || start <= 0 ||
+          start >= std::stod(value("Simulation/End time")))
+        return {};
+      std::vector<std::string> preparation;
+      for (std::size_t i = 0; i < c.overrides.size(); ++i)
+        if (!acts_only_after_shear_start(c.entries[i]) &&
+            std::find(shear_phase.begin(), shear_phase.end(), c.entries[i]) == shear_phase.end())
+          preparation.push_back(c.overrides[i]);
+      preparation.push_back("Simulation/End time=" + value("Shear cell/Shear start"));
+      preparation.push_back("Output/Plots=false");
+      if (!coupling::is_wall_of_discs(c.value(preparation, "Shear cell/Upper body model")))
+        return {};
+      return preparation;
+    }
+  } // namespace
+
   std::unique_ptr<Scene> make_shear_scene(const ParameterFile &f, const CaseParameters &p)
   {
     return std::make_unique<ShearCellScene>(p, ShearCellParameters::parse(f, p));
@@ -747,6 +784,7 @@ namespace tribo::app
       if (!cell.initial_state.empty())
         f.set("Shear cell/Initial state=" + cell.initial_state);
     };
+    hooks.compaction_of = compaction_of;
     return hooks;
   }
 } // namespace tribo::app
