@@ -42,13 +42,13 @@ namespace tribo::app
       {
         nx        = count(f, "MLP beams/Columns", 4);
         ny        = count(f, "MLP beams/Rows per beam", 2);
-        pressure  = checked(f, "MLP beams/Pressure", is_non_negative, "a pressure >= 0 in Pa");
-        tau       = checked(f, "MLP beams/Transverse traction", is_non_negative, "a traction amplitude >= 0 in Pa");
-        freq      = checked(f, "MLP beams/Frequency", is_positive, "a positive frequency in Hz");
-        offset    = checked(f, "MLP beams/Interface offset", [](double v) { return v >= 0 && v < 1; },
+        pressure  = f.get_checked("MLP beams/Pressure", is_non_negative, "a pressure >= 0 in Pa");
+        tau       = f.get_checked("MLP beams/Transverse traction", is_non_negative, "a traction amplitude >= 0 in Pa");
+        freq      = f.get_checked("MLP beams/Frequency", is_positive, "a positive frequency in Hz");
+        offset    = f.get_checked("MLP beams/Interface offset", [](double v) { return v >= 0 && v < 1; },
                             "a fraction of r0 in [0, 1)");
-        start     = checked(f, "MLP beams/Profile start", is_non_negative, "a time >= 0 in s");
-        layer     = checked(f, "MLP beams/Layer thickness", is_positive,
+        start     = f.get_checked("MLP beams/Profile start", is_non_negative, "a time >= 0 in s");
+        layer     = f.get_checked("MLP beams/Layer thickness", is_positive,
                             "a positive thickness in row spacings, e.g. 1"); // times h_row in build()
         body_load = f.get("MLP beams/Transverse load on") == "body";
       }

@@ -48,16 +48,16 @@ namespace tribo::app
       {
         nx       = count(f, "MLP compression/Columns", 4);
         ny       = count(f, "MLP compression/Rows", 2);
-        pressure = checked(f, "MLP compression/Pressure", is_non_negative, "a pressure >= 0 in Pa");
-        rise     = checked(f, "MLP compression/Load rise time", is_non_negative, "a time >= 0 in s");
+        pressure = f.get_checked("MLP compression/Pressure", is_non_negative, "a pressure >= 0 in Pa");
+        rise     = f.get_checked("MLP compression/Load rise time", is_non_negative, "a time >= 0 in s");
         maps     = count(f, "MLP compression/Density maps", 0);
-        lambda   = checked(f, "MLP compression/Gaussian width", is_positive, "a positive lambda / r0^2, e.g. 1")
+        lambda   = f.get_checked("MLP compression/Gaussian width", is_positive, "a positive lambda / r0^2, e.g. 1")
                    * s.interaction.r0 * s.interaction.r0;
-        stop_h   = checked(f, "MLP compression/Stop at delta_h", [](double v) { return v >= 0 && v < 1; },
+        stop_h   = f.get_checked("MLP compression/Stop at delta_h", [](double v) { return v >= 0 && v < 1; },
                            "a fraction of the initial platen distance in [0, 1), e.g. 0.3");
-        probe[0] = checked(f, "MLP compression/First probe", [](double v) { return v >= 0 && v < 0.5; },
+        probe[0] = f.get_checked("MLP compression/First probe", [](double v) { return v >= 0 && v < 0.5; },
                            "a fraction of the slab length in [0, 0.5), e.g. 0.1");
-        probe[1] = checked(f, "MLP compression/Second probe", [&](double v) { return v > probe[0] && v <= 0.5; },
+        probe[1] = f.get_checked("MLP compression/Second probe", [&](double v) { return v > probe[0] && v <= 0.5; },
                            "a fraction of the slab length in (First probe, 0.5], e.g. 0.4");
         std::tie(youngs, c_l) = axial_theory(s);
       }

@@ -68,15 +68,15 @@ namespace tribo::app::mlp_scenes
                                                 : mlp::LatticeType::hexagonal;
     auto &ip  = s.interaction;
     ip.n      = mlp::symmetry_order(s.lattice);
-    ip.r0     = checked(f, "MLP/Spacing", is_positive, "a positive spacing r0 in m");
-    s.mass    = checked(f, "MLP/Particle mass", is_positive, "a positive mass in kg/m");
-    ip.stiffness = checked(f, "MLP/Pair stiffness", is_positive, "a positive k_c = U''(r0) in N/m^2");
-    ip.f0     = checked(f, "MLP/Return force amplitude", is_non_negative, "f0 >= 0 in N/m");
-    ip.width  = checked(f, "MLP/Well width", [](double v) { return v >= 1 && v <= 30; },
+    ip.r0     = f.get_checked("MLP/Spacing", is_positive, "a positive spacing r0 in m");
+    s.mass    = f.get_checked("MLP/Particle mass", is_positive, "a positive mass in kg/m");
+    ip.stiffness = f.get_checked("MLP/Pair stiffness", is_positive, "a positive k_c = U''(r0) in N/m^2");
+    ip.f0     = f.get_checked("MLP/Return force amplitude", is_non_negative, "f0 >= 0 in N/m");
+    ip.width  = f.get_checked("MLP/Well width", [](double v) { return v >= 1 && v <= 30; },
                        "a Morse width a r0 in [1, 30], e.g. 7");
     ip.form   = f.get("MLP/Return force form") == "potential" ? mlp::ReturnForceForm::potential
                                                              : mlp::ReturnForceForm::paper;
-    const double E = checked(f, "MLP/Young's modulus", is_non_negative,
+    const double E = f.get_checked("MLP/Young's modulus", is_non_negative,
                              "a 2D Young's modulus >= 0 in Pa (0: use Pair stiffness and Return force amplitude)");
     if (E > 0)
       {
@@ -101,11 +101,11 @@ namespace tribo::app::mlp_scenes
         throw InputError(f.filename() + ": subsection MLP: " + e.what());
       }
     auto &lp          = s.langevin;
-    lp.damping        = checked(f, "MLP/Damping", is_non_negative, "eta >= 0 in kg/(m s)");
-    lp.thermal_energy = checked(f, "MLP/Thermal energy", is_non_negative, "k_B T >= 0 in J/m");
-    lp.time_step      = checked(f, "MLP/Time step", is_non_negative, "a time step >= 0 in s (0: half the stable limit)");
+    lp.damping        = f.get_checked("MLP/Damping", is_non_negative, "eta >= 0 in kg/(m s)");
+    lp.thermal_energy = f.get_checked("MLP/Thermal energy", is_non_negative, "k_B T >= 0 in J/m");
+    lp.time_step      = f.get_checked("MLP/Time step", is_non_negative, "a time step >= 0 in s (0: half the stable limit)");
     lp.seed           = count(f, "MLP/Seed", 0);
-    s.end_time        = checked(f, "Simulation/End time", is_positive, "a positive end time in s");
+    s.end_time        = f.get_checked("Simulation/End time", is_positive, "a positive end time in s");
     s.statistics_interval = count(f, "MLP/Statistics interval", 1);
     s.snapshot_interval   = count(f, "MLP/Snapshot interval", 0);
     s.plots               = f.get_bool("Output/Plots");

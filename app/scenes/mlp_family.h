@@ -45,13 +45,6 @@ namespace tribo::app::mlp_scenes
     bool                       mapped = false; ///< k_c and f0 from (E, nu)
   };
 
-  /// A double entry that must satisfy @p ok (InputError naming the entry otherwise).
-  template <typename Check>
-  double checked(const ParameterFile &f, const std::string &path, Check ok, const std::string &expected)
-  {
-    return f.get_checked(path, ok, expected);
-  }
-
   /// A non-negative integer entry of at least @p min.
   unsigned int count(const ParameterFile &f, const std::string &path, long min);
 

@@ -30,14 +30,14 @@ namespace tribo::app
       OrderingScene(const ParameterFile &f, const CommonSettings &c) : s(c)
       {
         n_particles   = count(f, "MLP ordering/Particles", 2);
-        enlargement   = checked(f, "MLP ordering/Region enlargement", [](double v) { return v >= 1 && v <= 4; },
+        enlargement   = f.get_checked("MLP ordering/Region enlargement", [](double v) { return v >= 1 && v <= 4; },
                                 "a factor in [1, 4], e.g. 1.2");
-        aspect        = checked(f, "MLP ordering/Aspect ratio", is_positive, "a positive width/height ratio");
-        min_distance  = checked(f, "MLP ordering/Minimum distance", [](double v) { return v > 0 && v < 1; },
+        aspect        = f.get_checked("MLP ordering/Aspect ratio", is_positive, "a positive width/height ratio");
+        min_distance  = f.get_checked("MLP ordering/Minimum distance", [](double v) { return v > 0 && v < 1; },
                                 "a fraction of r0 in (0, 1), e.g. 0.75") * s.interaction.r0;
         relaxation    = count(f, "MLP ordering/Relaxation iterations", 0);
         grid          = count(f, "MLP ordering/Structure factor points", 11) | 1u;
-        q_range       = checked(f, "MLP ordering/Structure factor range", [](double v) { return v > 1.2; },
+        q_range       = f.get_checked("MLP ordering/Structure factor range", [](double v) { return v > 1.2; },
                                 "a multiple > 1.2 of the first Bragg wave number, e.g. 1.6");
       }
 
