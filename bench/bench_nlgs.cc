@@ -6,11 +6,7 @@
 //  and the resident memory the packing added, per disc.
 // Usage: bench_nlgs [CASE.prm] [compaction steps] [timed steps] [--set "Section/Entry=value"]...
 // (bench/nlgs_scaling.sh runs it on 1k to 64k discs.)
-#include "app/case_parameters.h"
-#include "app/scene_hooks.h"
-#include "app/scenes.h"
-#include "core/parameter_file.h"
-#include "dem/engine/moreau_jean.h"
+#include "bench/bench_case.h"
 
 #include <chrono>
 #include <cstdio>
@@ -43,30 +39,16 @@ namespace
 
 int main(int argc, char **argv)
 {
-  std::vector<std::string> positional, overrides;
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--set" && i + 1 < argc)
-      overrides.push_back(argv[++i]);
-    else
-      positional.push_back(argv[i]);
-  const std::string case_file     = positional.size() > 0 ? positional[0] : "cases/shear/bench.prm";
-  const unsigned    compact_steps = positional.size() > 1 ? std::stoul(positional[1]) : 3000;
-  const unsigned    timed_steps   = positional.size() > 2 ? std::stoul(positional[2]) : 100;
-  const double      memory_before = resident_mb();
-
-  dealii::ParameterHandler prm;
-  app::declare_case_parameters(prm);
-  ParameterFile file(prm);
-  file.parse(case_file);
-  for (const auto &o : overrides)
-    file.set(o);
-  const app::CaseParameters p = app::read_case_parameters(file);
-
-  auto                scene = app::make_shear_scene(file, p);
-  dem::ParticleSystem system;
-  scene->build(system);
-  const double    h = scene->time_step(system);
-  dem::MoreauJean mj(p.theta, p.law, p.solver, p.law.detection_distance > 0 ? p.law.detection_distance : 0.1 * system.min_radius());
+  const double     memory_before = resident_mb();
+  bench::BenchCase bench_case(argc, argv, "cases/shear/bench.prm");
+  const std::string case_file     = bench_case.case_file("cases/shear/bench.prm");
+  const unsigned    compact_steps = bench_case.count(1, 3000);
+  const unsigned    timed_steps   = bench_case.count(2, 100);
+  const app::CaseParameters &p      = bench_case.parameters;
+  auto                      &scene  = bench_case.scene;
+  dem::ParticleSystem       &system = bench_case.system;
+  const double               h      = bench_case.h;
+  dem::MoreauJean           &mj     = *bench_case.integrator;
 
   std::printf("case %s: %zu discs, h = %g s\n", case_file.c_str(), system.discs.size(), h);
   app::NscdWorld world{system};

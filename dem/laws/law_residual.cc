@@ -12,7 +12,7 @@ namespace tribo::dem
   {
     LawResidual  result;
     double       loaded_sum = 0, max_phi2 = 0, min_rate = 0;
-    unsigned int loaded     = 0;
+    unsigned int &loaded    = result.loaded;
     const bool   iqs        = law.type == ContactLaw::Type::iqs;
     for (std::size_t i = 0; i < contacts.size(); ++i)
       {

@@ -31,6 +31,7 @@ namespace tribo::dem
     double relative      = 0; ///< max |phi| / mean loaded r~, dimensionless
     double max_phi       = 0; ///< max |phi| = max sqrt(phi_n^2 + phi_t^2), N s/m
     double mean_impulse  = 0; ///< mean r~ over the contacts with r~ > 0, N s/m
+    unsigned int loaded  = 0; ///< contacts with r~ > 0 (mean_impulse's count)
     double gap_violation = 0; ///< theta h max(0, -(u_n + b)) over IQS contacts, m
     unsigned int worst   = 0; ///< index of the contact with the largest |phi|
   };

@@ -208,20 +208,7 @@ namespace tribo::dem
 
     auto solve_band = [&](unsigned int k) {
       for (unsigned int i = begin[k]; i < begin[k + 1]; ++i)
-        {
-          Contact              &c       = contacts[order[i]];
-          const Eigen::Vector2d u_now   = state.local_velocity(c);
-          const Eigen::Vector2d r_old   = c.r;
-          const Eigen::Vector2d u_other = u_now - c.W * r_old;
-          const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
-          Eigen::Vector2d       r_new   = law.solve(c.W, u_other, terms);
-          if (omega != 1.0)
-            r_new = omega * r_new + (1 - omega) * r_old;
-          const Eigen::Vector2d dr = r_new - r_old;
-          if (dr.x() != 0 || dr.y() != 0)
-            state.apply_impulse(c, dr);
-          c.r = r_new;
-        }
+        gauss_seidel_update(contacts[order[i]], state, law, omega);
     };
     // The check pass over band k: every contact's local solve against the state the
     // sweeps left, nothing applied (as the established code does: a sweep's own changes

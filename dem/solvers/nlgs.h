@@ -28,6 +28,22 @@
 
 namespace tribo::dem
 {
+  /// One local solve of the Gauss-Seidel sweep: contact @p c's impulse from its law against
+  /// the current velocities of @p state (u_other = u - W r), relaxed, r <- omega r_law +
+  /// (1 - omega) r, and its change applied to @p state (v += M^-1 H dr).
+  inline void gauss_seidel_update(Contact &c, BodyState &state, const ContactLaw &law, double omega)
+  {
+    const Eigen::Vector2d   u_other = state.local_velocity(c) - c.W * c.r;
+    const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
+    Eigen::Vector2d         r_new = law.solve(c.W, u_other, terms);
+    if (omega != 1.0)
+      r_new = omega * r_new + (1 - omega) * c.r;
+    const Eigen::Vector2d dr = r_new - c.r;
+    if (dr.x() != 0 || dr.y() != 0)
+      state.apply_impulse(c, dr);
+    c.r = r_new;
+  }
+
   /// The solver; it keeps its random generator across steps (reproducible from the seed).
   class NlgsSolver : public ContactSolver
   {

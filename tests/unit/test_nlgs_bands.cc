@@ -1,7 +1,7 @@
 // The banded NLGS (SolverParameters::threads > 1) and the interleaved streams: each is the
 // serial Gauss-Seidel sweep in its own order, bit for bit, and a banded run solves the
 // law as the serial run does.
-#include "dem/engine/moreau_jean.h"
+#include "tests/unit/tall_layer.h"
 
 #include <gtest/gtest.h>
 
@@ -9,72 +9,7 @@
 #include <vector>
 
 using namespace tribo::dem;
-
-namespace
-{
-  const double rho = 7800, radius = 0.5e-6;
-
-  /// A hexagonal stack of 8 x 24 discs (d = 1 um, 2 % gaps) between a sliding lower
-  /// wall and a loaded upper wall, period 8 um: tall enough for four bands of contacts.
-  ParticleSystem tall_layer()
-  {
-    ParticleSystem s;
-    s.period = 8e-6;
-    std::vector<Vec2>   c;
-    std::vector<double> rad;
-    for (int i = 0; i < 8; ++i)
-      {
-        c.push_back({(i + 0.5) * 1e-6, 0});
-        rad.push_back(radius);
-      }
-    const unsigned lower = s.add_clump(c, rad, rho);
-    for (auto &d : s.bodies[lower].drive)
-      d = Drive::velocity;
-    s.bodies[lower].velocity = {1.0, 0};
-    const double dy = 1.02e-6 * std::sqrt(3.0) / 2;
-    for (int j = 0; j < 24; ++j)
-      for (int i = 0; i < 8; ++i)
-        s.add_disc({(i + 0.5 * (j % 2)) * 1.02e-6, 1.02e-6 + j * dy}, radius, rho);
-    for (auto &p : c)
-      p.y() = 1.02e-6 + 24 * dy;
-    const unsigned upper = s.add_clump(c, rad, rho);
-    s.bodies[upper].drive   = {{Drive::velocity, Drive::force, Drive::velocity}};
-    s.bodies[upper].load[1] = -800.0;
-    s.bodies[upper].velocity = {0, -1.0};
-    return s;
-  }
-
-  /// The contacts of tall_layer() after 20 steps, with their impulses reset (a cold
-  /// start: the fixed sweeps below have real work to do), and the state they act on.
-  struct ColdStart
-  {
-    ParticleSystem       system = tall_layer();
-    ContactLaw           law;
-    std::vector<Contact> contacts;
-    ColdStart()
-    {
-      SolverParameters prm;
-      prm.method    = SolverParameters::Method::nlgs;
-      prm.tolerance = 1e-3;
-      MoreauJean mj(0.5, law, prm, 5e-8);
-      for (int i = 0; i < 20; ++i)
-        mj.step(system, 1e-9);
-      contacts = mj.contacts();
-      for (auto &c : contacts)
-        c.r.setZero();
-    }
-  };
-
-  /// Exactly @p sweeps sweeps (a tolerance never met).
-  SolverParameters fixed_sweeps(unsigned int sweeps)
-  {
-    SolverParameters p;
-    p.method         = SolverParameters::Method::nlgs;
-    p.tolerance      = 1e-300;
-    p.max_iterations = sweeps;
-    return p;
-  }
-} // namespace
+using namespace tribo::dem::test;
 
 TEST(NlgsBands, ConcurrentSweepIsTheSerialSweepInBandOrder)
 {

@@ -1,0 +1,102 @@
+// The contact solve of one step across MPI ranks (dem/parallel/): how many more sweeps the
+// coupling across ranks takes than the serial Gauss-Seidel, and the time per sweep.
+// Every rank runs the same serial trajectory of CASE for STEPS steps (no distributed
+// engine yet), then takes the last step's own problem (its free velocities: the end
+// velocities less the impulses' effect), warm-started as the engine does (each contact from
+// its impulse of the step before) or cold, splits it into bands and solves it on all ranks,
+// and on one rank, to each target. docs/scaling.md records it.
+// Usage: mpirun -np N bench_distributed [CASE.prm] [STEPS] [--set "Section/Entry=value"]...
+#include "bench/bench_case.h"
+#include "dem/parallel/distributed_gauss_seidel.h"
+
+#include <deal.II/base/mpi.h>
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+using namespace tribo;
+using Clock = std::chrono::steady_clock;
+
+int main(int argc, char **argv)
+{
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const MPI_Comm     world = MPI_COMM_WORLD;
+  const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(world);
+  const unsigned int n    = dealii::Utilities::MPI::n_mpi_processes(world);
+  bench::BenchCase bench_case(argc, argv, "cases/shear/reference_bench_sample.prm");
+  const std::string case_file = bench_case.case_file("cases/shear/reference_bench_sample.prm");
+  const unsigned    steps     = bench_case.count(1, 50);
+  const app::CaseParameters &p      = bench_case.parameters;
+  dem::ParticleSystem       &system = bench_case.system;
+  const double               h      = bench_case.h;
+  dem::MoreauJean           &mj     = *bench_case.integrator;
+  app::NscdWorld             nscd{system};
+  std::map<std::uint64_t, Eigen::Vector2d> before_last;
+  for (unsigned s = 0; s < steps; ++s)
+    {
+      if (s + 1 == steps)
+        for (const auto &c : mj.contacts())
+          before_last[c.key()] = c.r;
+      nscd.step = s;
+      bench_case.scene->before_step(nscd);
+      mj.step(system, h);
+    }
+  // The last step's problem: its free velocities, its contacts cold.
+  std::vector<dem::Contact> contacts = mj.contacts();
+  dem::BodyState            free     = dem::BodyState::of(system);
+  for (auto &c : contacts)
+    {
+      free.apply_impulse(c, -c.r);
+      c.r.setZero();
+    }
+  // Warm-started: the impulses of the step before, their effect in the state.
+  std::vector<dem::Contact> warm_contacts = contacts;
+  dem::BodyState            warm          = free;
+  for (auto &c : warm_contacts)
+    if (const auto it = before_last.find(c.key()); it != before_last.end())
+      {
+        c.r = it->second;
+        warm.apply_impulse(c, c.r);
+      }
+  if (rank == 0)
+    std::printf("case %s after %u steps: %zu discs, %zu contacts, %u ranks\n", case_file.c_str(), steps,
+                system.discs.size(), contacts.size(), n);
+
+  for (const bool warm_start : {true, false})
+  for (const double target : {1e-2, 1e-3, 1e-4})
+    {
+      auto solve_on = [&](MPI_Comm comm) {
+        const unsigned int ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+        const auto &problem = warm_start ? warm_contacts : contacts;
+        dem::parallel::RankProblem share =
+          dem::parallel::share_of(system, problem, warm_start ? warm : free,
+                                  dem::parallel::contact_bands(system, problem, ranks),
+                                  dealii::Utilities::MPI::this_mpi_process(comm));
+        dem::parallel::DistributedControls controls;
+        controls.residual_target = target;
+        controls.max_sweeps      = 200000;
+        dem::parallel::DistributedGaussSeidel solver(share, comm);
+        MPI_Barrier(comm);
+        const auto t0     = Clock::now();
+        const auto report = solver.solve(share, mj.law(), controls, p.theta * h);
+        const double t    = std::chrono::duration<double>(Clock::now() - t0).count();
+        const double slowest = dealii::Utilities::MPI::max(t, comm);
+        const double ghosts  = dealii::Utilities::MPI::sum(double(share.n_ghost), comm);
+        return std::make_tuple(report, slowest, ghosts);
+      };
+      const auto [serial, serial_time, serial_ghosts] = solve_on(MPI_COMM_SELF);
+      const auto [here, here_time, ghosts]            = solve_on(world);
+      (void)serial_ghosts;
+      if (rank == 0)
+        std::printf("%s, target %g: %u ranks %u sweeps (law residual %.2e) in %.3f s, one rank %u sweeps in %.3f s: "
+                    "sweeps x %.3f, %.0f ghost grains in all, %.2f ms per sweep against %.2f\n",
+                    warm_start ? "warm" : "cold", target, n, here.sweeps, here.law_residual, here_time, serial.sweeps, serial_time,
+                    double(here.sweeps) / serial.sweeps, ghosts, 1e3 * here_time / here.sweeps,
+                    1e3 * serial_time / serial.sweeps);
+    }
+  return 0;
+}

@@ -1,0 +1,113 @@
+#include "dem/parallel/distributed_gauss_seidel.h"
+
+#include "dem/laws/law_residual.h"
+#include "dem/solvers/nlgs.h"
+
+#include <deal.II/base/index_set.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/partitioner.h>
+#include <deal.II/lac/la_parallel_vector.h>
+
+#include <algorithm>
+#include <array>
+
+namespace tribo::dem::parallel
+{
+  /// The distributed vector of the grains' velocities, three entries per grain
+  /// (v_x, v_y, spin at 3 g, 3 g + 1, 3 g + 2 for global grain g).
+  struct DistributedGaussSeidel::Exchange
+  {
+    dealii::LinearAlgebra::distributed::Vector<double> v;
+    unsigned int                                        owned_entries = 0, ghost_entries = 0;
+  };
+
+  DistributedGaussSeidel::DistributedGaussSeidel(const RankProblem &p, MPI_Comm comm)
+    : exchange(std::make_unique<Exchange>())
+    , comm(comm)
+  {
+    dealii::IndexSet owned(3 * p.n_grains), ghosts(3 * p.n_grains);
+    if (p.n_owned > 0)
+      owned.add_range(3 * p.global_grain[0], 3 * (p.global_grain[p.n_owned - 1] + 1));
+    for (unsigned int l = p.n_owned; l < p.n_owned + p.n_ghost; ++l)
+      ghosts.add_range(3 * p.global_grain[l], 3 * (p.global_grain[l] + 1));
+    owned.compress();
+    ghosts.compress();
+    exchange->v.reinit(owned, ghosts, comm);
+    exchange->owned_entries = 3 * p.n_owned;
+    exchange->ghost_entries = 3 * p.n_ghost;
+  }
+
+  DistributedGaussSeidel::~DistributedGaussSeidel() = default;
+
+  DistributedReport DistributedGaussSeidel::solve(RankProblem &p, const ContactLaw &law,
+                                                  const DistributedControls &controls, double theta_h)
+  {
+    DistributedReport report;
+    auto             &v          = exchange->v;
+    const unsigned    first_rep  = p.n_owned + p.n_ghost, n_local = static_cast<unsigned>(p.serial_body.size());
+    const unsigned    n_rep      = n_local - first_rep;
+    std::vector<Eigen::Vector3d> before(n_local - p.n_owned);
+    std::vector<double>          wall_change(3 * n_rep), wall_sum(3 * n_rep);
+
+    for (unsigned int sweep = 1; sweep <= controls.max_sweeps; ++sweep)
+      {
+        for (unsigned int l = p.n_owned; l < n_local; ++l)
+          before[l - p.n_owned] = p.state.velocity[l];
+        for (Contact &c : p.contacts)
+          gauss_seidel_update(c, p.state, law, 1.0);
+
+        // Ghost-to-owner: the changes this rank made to ghosts, added by their owners.
+        v = 0.;
+        for (unsigned int j = 0; j < p.n_ghost; ++j)
+          for (unsigned int k = 0; k < 3; ++k)
+            v.local_element(exchange->owned_entries + 3 * j + k) =
+              p.state.velocity[p.n_owned + j][k] - before[j][k];
+        v.compress(dealii::VectorOperation::add);
+        for (unsigned int l = 0; l < p.n_owned; ++l)
+          for (unsigned int k = 0; k < 3; ++k)
+            {
+              p.state.velocity[l][k] += v.local_element(3 * l + k);
+              v.local_element(3 * l + k) = p.state.velocity[l][k];
+            }
+        // Owner-to-ghost.
+        v.update_ghost_values();
+        for (unsigned int j = 0; j < p.n_ghost; ++j)
+          for (unsigned int k = 0; k < 3; ++k)
+            p.state.velocity[p.n_owned + j][k] = v.local_element(exchange->owned_entries + 3 * j + k);
+        // The replicated bodies: every rank's changes summed.
+        if (n_rep > 0)
+          {
+            for (unsigned int j = 0; j < n_rep; ++j)
+              for (unsigned int k = 0; k < 3; ++k)
+                wall_change[3 * j + k] = p.state.velocity[first_rep + j][k] - before[p.n_ghost + j][k];
+            dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(wall_change),
+                                        comm, dealii::ArrayView<double>(wall_sum));
+            for (unsigned int j = 0; j < n_rep; ++j)
+              for (unsigned int k = 0; k < 3; ++k)
+                p.state.velocity[first_rep + j][k] = before[p.n_ghost + j][k] + wall_sum[3 * j + k];
+          }
+        report.sweeps = sweep;
+        if (sweep % controls.check_interval != 0 && sweep != controls.max_sweeps)
+          continue;
+
+        // The law residual over every rank's contacts: max |phi| and the gap violation
+        // (maxima), the loaded impulses' sum and count (sums).
+        ++report.checks;
+        const LawResidual local     = law_residual(p.contacts, p.state, law, theta_h);
+        const double      loaded[2] = {local.mean_impulse * local.loaded, double(local.loaded)};
+        const double maxima[2] = {local.max_phi, local.gap_violation};
+        double       global_max[2], global_loaded[2];
+        dealii::Utilities::MPI::max(maxima, comm, global_max);
+        dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
+        const double mean     = global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : 0;
+        report.law_residual   = mean > 0 ? global_max[0] / mean : (global_max[0] > 0 ? 1 : 0);
+        report.gap_violation  = global_max[1];
+        if (report.law_residual <= controls.residual_target)
+          {
+            report.converged = true;
+            break;
+          }
+      }
+    return report;
+  }
+} // namespace tribo::dem::parallel

@@ -1,0 +1,108 @@
+#include "dem/parallel/rank_problem.h"
+
+#include "core/errors.h"
+
+#include <algorithm>
+
+namespace tribo::dem::parallel
+{
+  namespace
+  {
+    /// Height of the midpoint of contact @p c's two disc centres, m.
+    double contact_height(const ParticleSystem &system, const Contact &c)
+    {
+      return 0.5 * (system.disc_centre(c.disc[0]).y() + system.disc_centre(c.disc[1]).y());
+    }
+
+    /// Bodies of one disc (grains); the others (clumps) are replicated.
+    std::vector<bool> grains_of(const ParticleSystem &system)
+    {
+      std::vector<unsigned int> discs(system.bodies.size(), 0);
+      for (const Disc &d : system.discs)
+        ++discs[d.body];
+      std::vector<bool> grain(system.bodies.size());
+      for (std::size_t b = 0; b < grain.size(); ++b)
+        grain[b] = discs[b] == 1;
+      return grain;
+    }
+  } // namespace
+
+  BandPartition contact_bands(const ParticleSystem &system, const std::vector<Contact> &contacts, unsigned int n)
+  {
+    std::vector<double> y;
+    y.reserve(contacts.size());
+    for (const Contact &c : contacts)
+      y.push_back(contact_height(system, c));
+    return BandPartition::balanced(std::move(y), n);
+  }
+
+  RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts, const BodyState &state,
+                       const BandPartition &bands, unsigned int rank)
+  {
+    const std::size_t       n_bodies = system.bodies.size();
+    const std::vector<bool> grain    = grains_of(system);
+
+    // Global numbers: the grains band by band, each band's in serial order.
+    std::vector<unsigned int> band(n_bodies, 0);
+    std::vector<std::uint64_t> count(bands.n_bands() + 1, 0);
+    for (std::size_t b = 0; b < n_bodies; ++b)
+      if (grain[b])
+        ++count[(band[b] = bands.band_of(system.bodies[b].position.y())) + 1];
+    for (unsigned int k = 0; k < bands.n_bands(); ++k)
+      count[k + 1] += count[k]; // count[k]: the first global number of band k
+    RankProblem p;
+    p.n_grains = count[bands.n_bands()];
+    std::vector<std::uint64_t> global(n_bodies, 0);
+    for (std::size_t b = 0; b < n_bodies; ++b)
+      if (grain[b])
+        global[b] = count[band[b]]++;
+
+    // Owned contacts, and the grains they touch.
+    std::vector<bool> touched(n_bodies, false);
+    for (std::size_t i = 0; i < contacts.size(); ++i)
+      {
+        const Contact &c = contacts[i];
+        if (c.on_boundary())
+          throw RunError("a contact with a half-disc element: a deformable first body is not yet "
+                         "distributed over MPI ranks (dem/parallel/README.md)");
+        if (bands.band_of(contact_height(system, c)) != rank)
+          continue;
+        p.serial_contact.push_back(static_cast<unsigned int>(i));
+        touched[c.body[0]] = touched[c.body[1]] = true;
+      }
+    std::vector<unsigned int> owned, ghosts, replicated;
+    for (unsigned int b = 0; b < n_bodies; ++b)
+      if (!grain[b])
+        replicated.push_back(b);
+      else if (band[b] == rank)
+        owned.push_back(b);
+      else if (touched[b])
+        ghosts.push_back(b);
+    const auto by_global = [&](unsigned int a, unsigned int b) { return global[a] < global[b]; };
+    std::sort(owned.begin(), owned.end(), by_global);
+    std::sort(ghosts.begin(), ghosts.end(), by_global);
+    p.n_owned = static_cast<unsigned int>(owned.size());
+    p.n_ghost = static_cast<unsigned int>(ghosts.size());
+    for (const auto *list : {&owned, &ghosts, &replicated})
+      p.serial_body.insert(p.serial_body.end(), list->begin(), list->end());
+
+    std::vector<unsigned int> local(n_bodies, 0);
+    for (unsigned int l = 0; l < p.serial_body.size(); ++l)
+      {
+        const unsigned int b = p.serial_body[l];
+        local[b]             = l;
+        p.state.velocity.push_back(state.velocity[b]);
+        p.state.inverse_mass.push_back(state.inverse_mass[b]);
+        if (l < p.n_owned + p.n_ghost)
+          p.global_grain.push_back(global[b]);
+      }
+    for (const unsigned int i : p.serial_contact)
+      {
+        Contact c = contacts[i];
+        c.body[0] = local[c.body[0]];
+        c.body[1] = local[c.body[1]];
+        p.contacts.push_back(c);
+      }
+    return p;
+  }
+} // namespace tribo::dem::parallel

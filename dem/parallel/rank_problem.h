@@ -1,0 +1,50 @@
+#pragma once
+/// @file One rank's share of a step's contact problem under horizontal bands
+/// (dem/parallel/README.md): the contacts it owns, its own grains, the ghost grains its
+/// contacts touch and the replicated bodies (the walls).
+
+#include "dem/engine/body_state.h"
+#include "dem/engine/contact.h"
+#include "dem/engine/particle_system.h"
+#include "dem/parallel/band_partition.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace tribo::dem::parallel
+{
+  /// The contacts a rank owns and the bodies they act on, numbered locally.
+  ///
+  /// Grains (bodies of one disc) are owned by the band of their centre's height and
+  /// numbered globally band by band (band 0's grains first, each band's in serial order),
+  /// so that each rank owns one contiguous range, as deal.II's partitioner wants. A contact
+  /// is owned by the band of the midpoint of its two discs' centres, which is the band of
+  /// one of its grains. Clumps (the walls: a few degrees of freedom) are replicated on
+  /// every rank.
+  struct RankProblem
+  {
+    /// The owned contacts in serial (detection) order, their bodies numbered locally.
+    std::vector<Contact> contacts;
+    /// Local bodies: owned grains (by global number), ghost grains (by global number),
+    /// replicated bodies (in serial order). Velocities m/s and rad/s.
+    BodyState    state;
+    unsigned int n_owned = 0, n_ghost = 0;
+    /// Serial index of each local body and of each owned contact.
+    std::vector<unsigned int> serial_body, serial_contact;
+    /// Global number of each owned and ghost grain (local bodies 0 .. n_owned + n_ghost).
+    std::vector<std::uint64_t> global_grain;
+    std::uint64_t              n_grains = 0; ///< grains on all ranks
+
+    unsigned int n_replicated() const { return static_cast<unsigned int>(serial_body.size()) - n_owned - n_ghost; }
+  };
+
+  /// Bands of equal contact counts for @p n ranks, by the contacts' midpoint heights.
+  BandPartition contact_bands(const ParticleSystem &system, const std::vector<Contact> &contacts, unsigned int n);
+
+  /// Rank @p rank's share of the serial problem @p contacts on @p state (a BodyState over
+  /// @p system's bodies, consistent with the contacts' impulses) under @p bands. Every rank
+  /// calls it with the same serial problem. Throws RunError for a half-disc contact (a
+  /// deformable first body is not yet distributed).
+  RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts, const BodyState &state,
+                       const BandPartition &bands, unsigned int rank);
+} // namespace tribo::dem::parallel

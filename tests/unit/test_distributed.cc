@@ -1,0 +1,275 @@
+// The contact solve across MPI ranks (dem/parallel/): run by ctest on 1, 2, 3 and 4 ranks
+// (tests/unit/CMakeLists.txt). Every assertion follows the collective calls, so that a
+// failure on one rank cannot leave the others waiting.
+#include "dem/parallel/distributed_gauss_seidel.h"
+#include "tests/unit/tall_layer.h"
+
+#include <deal.II/base/mpi.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+using namespace tribo::dem;
+using namespace tribo::dem::parallel;
+using namespace tribo::dem::test;
+
+namespace
+{
+  MPI_Comm     world() { return MPI_COMM_WORLD; }
+  unsigned int n_ranks() { return dealii::Utilities::MPI::n_mpi_processes(world()); }
+  unsigned int my_rank() { return dealii::Utilities::MPI::this_mpi_process(world()); }
+
+  /// @p values summed over the ranks.
+  std::vector<double> summed(const std::vector<double> &values)
+  {
+    std::vector<double> sum(values.size());
+    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(values), world(), dealii::ArrayView<double>(sum));
+    return sum;
+  }
+
+  /// The velocities of every body of the serial numbering after a distributed solve: each
+  /// grain's from its owner, the replicated bodies' from rank 0 (summed over the ranks,
+  /// each body written by exactly one).
+  std::vector<Eigen::Vector3d> gathered_velocities(const RankProblem &p, std::size_t n_bodies)
+  {
+    std::vector<double> v(3 * n_bodies, 0.0);
+    for (unsigned int l = 0; l < p.serial_body.size(); ++l)
+      if (l < p.n_owned || (l >= p.n_owned + p.n_ghost && my_rank() == 0))
+        for (unsigned int k = 0; k < 3; ++k)
+          v[3 * p.serial_body[l] + k] = p.state.velocity[l][k];
+    const std::vector<double> sum = summed(v);
+    std::vector<Eigen::Vector3d> out(n_bodies);
+    for (std::size_t b = 0; b < n_bodies; ++b)
+      out[b] = {sum[3 * b], sum[3 * b + 1], sum[3 * b + 2]};
+    return out;
+  }
+
+  /// The impulse (x, y) the contacts put on body @p body, summed
+  /// over every rank's contacts, N s/m.
+  Eigen::Vector2d impulse_on(const std::vector<Contact> &contacts, const std::vector<unsigned int> &local_to_serial,
+                             unsigned int body, bool distributed)
+  {
+    double f[2] = {0, 0};
+    for (const Contact &c : contacts)
+      for (int s = 0; s < 2; ++s)
+        if (local_to_serial[c.body[s]] == body)
+          {
+            const Vec2 t(-c.normal.y(), c.normal.x());
+            const Vec2 on = (s == 0 ? -1.0 : 1.0) * (c.r.x() * c.normal + c.r.y() * t);
+            f[0] += on.x();
+            f[1] += on.y();
+          }
+    if (!distributed)
+      return {f[0], f[1]};
+    double total[2];
+    dealii::Utilities::MPI::sum(f, world(), total);
+    return {total[0], total[1]};
+  }
+
+  std::vector<unsigned int> identity(std::size_t n)
+  {
+    std::vector<unsigned int> i(n);
+    std::iota(i.begin(), i.end(), 0u);
+    return i;
+  }
+
+  /// The serial reference: NLGS to a tight tolerance.
+  struct SerialReference
+  {
+    std::vector<Contact> contacts;
+    BodyState            state;
+    SolveReport          report;
+    SerialReference(const ColdStart &cold, double tolerance)
+      : contacts(cold.contacts)
+      , state(BodyState::of(cold.system))
+    {
+      SolverParameters prm;
+      prm.method         = SolverParameters::Method::nlgs;
+      prm.tolerance      = tolerance;
+      prm.max_iterations = 200000;
+      report             = NlgsSolver(prm).solve(contacts, state, cold.law);
+    }
+  };
+} // namespace
+
+TEST(Distributed, BandsHoldEqualCountsAndEveryHeightHasOneBand)
+{
+  std::vector<double> y;
+  for (int i = 0; i < 1000; ++i)
+    y.push_back(std::sin(0.37 * i) * 1e-5); // distinct heights, not sorted
+  for (unsigned int n = 1; n <= 7; ++n)
+    {
+      const BandPartition bands = BandPartition::balanced(y, n);
+      ASSERT_EQ(bands.n_bands(), n);
+      std::vector<unsigned int> count(n, 0);
+      for (const double h : y)
+        ++count[bands.band_of(h)];
+      for (unsigned int k = 0; k < n; ++k)
+        {
+          EXPECT_GE(count[k], 1000 / n) << n << " bands, band " << k;
+          EXPECT_LE(count[k], 1000 / n + 1) << n << " bands, band " << k;
+          EXPECT_LT(bands.cut[k], bands.cut[k + 1]);
+        }
+      EXPECT_LE(bands.imbalance(y), double(1000 / n + 1) * n / 1000);
+    }
+  // All heights in one band of two: imbalance 2.
+  const BandPartition halves = BandPartition::balanced(y, 2);
+  EXPECT_DOUBLE_EQ(halves.imbalance(std::vector<double>(10, -1.0)), 2.0);
+}
+
+TEST(Distributed, EveryGrainAndContactHasExactlyOneOwner)
+{
+  const ColdStart     cold;
+  const BandPartition bands = contact_bands(cold.system, cold.contacts, n_ranks());
+  const RankProblem   p     = share_of(cold.system, cold.contacts, BodyState::of(cold.system), bands, my_rank());
+
+  // Owned grains: one contiguous range of global numbers per rank, the ranges tiling
+  // [0, n_grains) in rank order; owned contacts: each serial contact on exactly one rank.
+  const std::size_t   n_bodies = cold.system.bodies.size();
+  std::vector<double> owner_count(n_bodies, 0.0), contact_count(cold.contacts.size(), 0.0);
+  for (unsigned int l = 0; l < p.n_owned; ++l)
+    owner_count[p.serial_body[l]] += 1;
+  for (const unsigned int i : p.serial_contact)
+    contact_count[i] += 1;
+  owner_count   = summed(owner_count);
+  contact_count = summed(contact_count);
+  const auto first = dealii::Utilities::MPI::all_gather(world(), p.n_owned ? p.global_grain[0] : p.n_grains);
+  const auto sizes = dealii::Utilities::MPI::all_gather(world(), p.n_owned);
+
+  const unsigned int n_grains = n_bodies - 2; // the two walls are clumps
+  EXPECT_EQ(p.n_grains, n_grains);
+  EXPECT_EQ(p.n_replicated(), 2u);
+  for (std::size_t b = 0; b < n_bodies; ++b)
+    EXPECT_EQ(owner_count[b], b == 0 || b == n_bodies - 1 ? 0.0 : 1.0) << "body " << b;
+  for (std::size_t i = 0; i < contact_count.size(); ++i)
+    EXPECT_EQ(contact_count[i], 1.0) << "contact " << i;
+  std::uint64_t next = 0;
+  for (unsigned int r = 0; r < n_ranks(); ++r)
+    {
+      if (sizes[r] > 0)
+        {
+          EXPECT_EQ(first[r], next) << "rank " << r;
+        }
+      next += sizes[r];
+    }
+  EXPECT_EQ(next, n_grains);
+  for (unsigned int l = 1; l < p.n_owned; ++l)
+    EXPECT_EQ(p.global_grain[l], p.global_grain[l - 1] + 1);
+  // Every rank has work, and the bands hold equal contact counts as far as ties allow: a
+  // row of the lattice puts its horizontal contacts at one height, which one band takes.
+  EXPECT_GT(p.n_owned, 0u);
+  std::map<double, unsigned int> at_height;
+  unsigned int                   most_tied = 1;
+  for (const Contact &c : cold.contacts)
+    most_tied = std::max(most_tied, ++at_height[0.5 * (cold.system.disc_centre(c.disc[0]).y() +
+                                                        cold.system.disc_centre(c.disc[1]).y())]);
+  EXPECT_NEAR(double(p.contacts.size()), double(cold.contacts.size()) / n_ranks(), most_tied);
+  // A ghost is a grain of another band that an owned contact touches.
+  for (unsigned int l = p.n_owned; l < p.n_owned + p.n_ghost; ++l)
+    EXPECT_EQ(owner_count[p.serial_body[l]], 1.0);
+  if (n_ranks() == 1)
+    {
+      EXPECT_EQ(p.n_ghost, 0u);
+    }
+}
+
+TEST(Distributed, OnOneRankTheSweepsAreTheSerialNlgsSweeps)
+{
+  // Bit for bit: the same local solves in the same (detection) order.
+  if (n_ranks() != 1)
+    GTEST_SKIP() << "one rank only";
+  const ColdStart      cold;
+  std::vector<Contact> serial = cold.contacts;
+  BodyState            state  = BodyState::of(cold.system);
+  NlgsSolver(fixed_sweeps(37)).solve(serial, state, cold.law);
+
+  RankProblem p = share_of(cold.system, cold.contacts, BodyState::of(cold.system),
+                           contact_bands(cold.system, cold.contacts, 1), 0);
+  DistributedControls controls;
+  controls.residual_target = 0; // never met
+  controls.max_sweeps      = 37;
+  DistributedGaussSeidel(p, world()).solve(p, cold.law, controls);
+  ASSERT_EQ(p.contacts.size(), serial.size());
+  for (std::size_t i = 0; i < serial.size(); ++i)
+    EXPECT_EQ(p.contacts[i].r, serial[p.serial_contact[i]].r) << "contact " << i;
+  for (unsigned int l = 0; l < p.serial_body.size(); ++l)
+    EXPECT_EQ(p.state.velocity[l], state.velocity[p.serial_body[l]]) << "body " << p.serial_body[l];
+}
+
+namespace
+{
+  /// The loaded upper wall, which lands on the layer: the last body of tall_layer().
+  unsigned int upper_wall(const ColdStart &cold) { return static_cast<unsigned int>(cold.system.bodies.size()) - 1; }
+
+  /// Solve @p cold's problem on @p comm's ranks (MPI_COMM_SELF: the serial solve) to
+  /// @p target; the report, and the gathered velocities and upper wall's impulse.
+  struct Distributed
+  {
+    DistributedReport            report;
+    std::vector<Eigen::Vector3d> velocity;
+    Eigen::Vector2d              wall_impulse;
+    Distributed(const ColdStart &cold, double target, MPI_Comm comm)
+    {
+      const unsigned int n = dealii::Utilities::MPI::n_mpi_processes(comm);
+      RankProblem        p = share_of(cold.system, cold.contacts, BodyState::of(cold.system),
+                                      contact_bands(cold.system, cold.contacts, n),
+                                      dealii::Utilities::MPI::this_mpi_process(comm));
+      DistributedControls controls;
+      controls.residual_target = target;
+      controls.max_sweeps      = 100000;
+      report       = DistributedGaussSeidel(p, comm).solve(p, cold.law, controls);
+      wall_impulse = impulse_on(p.contacts, p.serial_body, upper_wall(cold), true);
+      if (comm == world())
+        velocity = gathered_velocities(p, cold.system.bodies.size());
+    }
+  };
+
+  /// The distributed solve against the serial interior point (frictionless) or NLGS
+  /// (friction) converged far below @p target: velocities and the upper wall's impulse.
+  void expect_serial_answer(const ColdStart &cold, double target, double velocity_bound, double impulse_bound)
+  {
+    SerialReference reference(cold, 1e-12);
+    const Distributed     here(cold, target, world());
+    const Distributed     one_rank(cold, target, MPI_COMM_SELF);
+    EXPECT_TRUE(here.report.converged);
+    EXPECT_LE(here.report.law_residual, target);
+    double worst = 0;
+    for (std::size_t b = 0; b < here.velocity.size(); ++b)
+      worst = std::max(worst, (here.velocity[b] - reference.state.velocity[b]).head<2>().lpNorm<Eigen::Infinity>());
+    EXPECT_LT(worst, velocity_bound);
+    const Eigen::Vector2d serial_impulse = impulse_on(reference.contacts, identity(cold.system.bodies.size()), upper_wall(cold), false);
+    EXPECT_LT((here.wall_impulse - serial_impulse).norm(), impulse_bound * serial_impulse.norm());
+    // The coupling across ranks costs sweeps; how many is what docs/scaling.md reports.
+    std::cout << "[ measure  ] " << n_ranks() << " ranks: " << here.report.sweeps << " sweeps (one rank "
+              << one_rank.report.sweeps << "), law residual " << here.report.law_residual
+              << ", worst velocity difference " << worst << " m/s, upper wall impulse " << here.wall_impulse.transpose()
+              << " against serial " << serial_impulse.transpose() << " N s/m" << std::endl;
+    EXPECT_LE(here.report.sweeps, 2 * one_rank.report.sweeps);
+  }
+} // namespace
+
+TEST(Distributed, FrictionlessSolveGivesTheSerialVelocitiesAndWallForce)
+{
+  // Without friction the velocities and the walls' impulses of a step are unique
+  // (docs/validation.md), so every rank count must give the serial ones.
+  expect_serial_answer(ColdStart(), 1e-9, 1e-6, 1e-6);
+}
+
+TEST(Distributed, CoulombFrictionSolveGivesTheSerialAnswer)
+{
+  ContactLaw law;
+  law.friction = 0.3;
+  expect_serial_answer(ColdStart(law), 1e-9, 1e-6, 1e-6);
+}
+
+int main(int argc, char **argv)
+{
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
