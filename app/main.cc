@@ -6,7 +6,9 @@
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -43,6 +45,16 @@ Exit codes: 0 success, 1 the run failed, 2 bad input, 128+N interrupted by signa
   [[noreturn]] void usage_error(const std::string &message)
   {
     throw tribo::InputError(message + " (see `tribo --help`)");
+  }
+
+  /// The number of processes mpirun started this one among (Open MPI's and MPICH's
+  /// launchers say so in the environment), 1 without a launcher.
+  int launched_ranks()
+  {
+    for (const char *name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+      if (const char *value = std::getenv(name))
+        return std::max(1, std::atoi(value));
+    return 1;
   }
 } // namespace
 
@@ -154,6 +166,12 @@ int main(int argc, char **argv)
         }
       if (o.case_file.empty())
         usage_error("'tribo " + args[0] + "' needs a case file");
+      if (const int ranks = launched_ranks(); ranks > 1 && !o.check_only)
+        throw tribo::InputError("'tribo run' was started on " + std::to_string(ranks) +
+                                " MPI ranks: a case runs in one process (only its contact solve is "
+                                "distributed yet, docs/scaling.md), and " + std::to_string(ranks) +
+                                " copies would write one output directory; run it without mpirun, "
+                                "or spread cases over ranks with 'tribo study'");
       return tribo::app::run_case(o);
     }
   catch (const tribo::InputError &e)

@@ -38,11 +38,11 @@ def case(changes):
 class BadInputTestCase(TempDirTestCase):
     """Helpers: run tribo on bad input and check the whole contract."""
 
-    def run_bad(self, args):
-        """Run `tribo ARGS` in self.tmp; check exit 2, one line on stderr, nothing
-        on stdout, no stack trace, nothing created. Returns the message."""
+    def run_bad(self, args, env=None):
+        """Run `tribo ARGS` in self.tmp (environment @p env); check exit 2, one line on
+        stderr, nothing on stdout, no stack trace, nothing created. Returns the message."""
         before = sorted(os.listdir(self.tmp))
-        r = run(args, cwd=self.tmp)
+        r = run(args, cwd=self.tmp, env=env)
         msg = r.stderr.strip()
         self.assertEqual(r.returncode, 2, "tribo %s: exit %d, stderr %r" % (" ".join(args), r.returncode, r.stderr))
         self.assertEqual(r.stdout, "", "nothing on stdout for bad input")
@@ -354,6 +354,14 @@ class CommandLine(BadInputTestCase):
     def test_unknown_option(self):
         msg = self.run_bad(["run", "good.prm", "--bogus"])
         self.assert_parts(msg, "unknown option '--bogus'", "tribo --help")
+
+    def test_run_under_mpirun_is_refused_before_writing(self):
+        # N copies of one case would write one output directory; `tribo check` still works.
+        env = dict(os.environ, OMPI_COMM_WORLD_SIZE="3")
+        msg = self.run_bad(["run", "good.prm", "--output", "out"], env=env)
+        self.assert_parts(msg, "'tribo run' was started on 3 MPI ranks", "one output directory",
+                          "without mpirun", "'tribo study'")
+        self.assertEqual(run(["check", "good.prm"], cwd=self.tmp, env=env).returncode, 0)
 
     def test_unknown_command(self):
         msg = self.run_bad(["frobnicate", "good.prm"])

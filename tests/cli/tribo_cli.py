@@ -70,10 +70,11 @@ def main():
     unittest.main(module="__main__", argv=[sys.argv[0]] + sys.argv[2:], verbosity=2)
 
 
-def run(args, cwd, timeout=120):
-    """Run tribo with @p args in directory @p cwd; returns the CompletedProcess (text)."""
+def run(args, cwd, timeout=120, env=None):
+    """Run tribo with @p args in directory @p cwd (and environment @p env, default ours);
+    returns the CompletedProcess (text)."""
     return subprocess.run([TRIBO] + list(args), cwd=cwd, stdout=subprocess.PIPE,
-                          stderr=subprocess.PIPE, universal_newlines=True, timeout=timeout)
+                          stderr=subprocess.PIPE, universal_newlines=True, timeout=timeout, env=env)
 
 
 def write_prm(path, sections, preamble=""):
