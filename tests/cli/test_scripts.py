@@ -195,6 +195,36 @@ def write_paper_reference(runs, name, figures):
                 "0,reference,x,complete,%s,case_000\n" % figures)
 
 
+def write_shear_study(runs, name, columns, cases):
+    """A study RUNS/name whose cases are {column: value} with mu_mean, mu_stderr, status,
+    error, and "eps" (mean |epsilon| in its window, m) and "profile" ((vx/V at 1/4, at 3/4),
+    linear between (0, 1) and (1, 0)) for each case's statistics.csv and profiles.csv."""
+    os.makedirs(os.path.join(runs, name))
+    header = ["case"] + columns + ["status", "mu_mean", "mu_stderr", "error", "directory"]
+    lines = [",".join(header)]
+    for k, c in enumerate(cases):
+        directory = os.path.join(runs, name, "case_%03d" % k)
+        os.makedirs(directory)
+        lines.append(",".join([str(k)] + [c[col] for col in columns] +
+                              [c.get("status", "complete"), str(c["mu"]), str(c.get("mu_se", 0.002)),
+                               c.get("error", ""), "case_%03d" % k]))
+        with open(os.path.join(directory, "summary.json"), "w") as f:
+            f.write('{"results": {"averaging_start": 0}}')
+        with open(os.path.join(directory, "statistics.csv"), "w") as f:
+            f.write("time,epsilon\n" + "".join("%r,%r\n" % (i * 1e-7, c.get("eps", 1e-11) * (1 + 0.01 * (i % 3 - 1)))
+                                                for i in range(40)))
+        quarter, three_quarters = c.get("profile", (0.75, 0.25))
+        ys = [(i + 0.5) / 10 for i in range(10)]
+        vs = np.interp(ys, [0, 0.25, 0.75, 1], [1, quarter, three_quarters, 0])
+        with open(os.path.join(directory, "profiles.csv"), "w") as f:
+            f.write("layer,y_over_h,vx,vx_stderr\n" + "".join("%d,%r,%r,0.1\n" % (i, y, 5 * v)
+                                                                for i, (y, v) in enumerate(zip(ys, vs))))
+        with open(os.path.join(directory, "parameters.prm"), "w") as f:
+            f.write("subsection Shear cell\n  set Sliding velocity = 5\nend\n")
+    with open(os.path.join(runs, name, "study_summary.csv"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
 def reproduction_rows(stdout):
     """{quantity: (ours, verdict)} of the table."""
     rows = [line.split(" | ") for line in stdout.splitlines() if line.startswith("| ") and "---" not in line]
@@ -263,6 +293,60 @@ class Reproduction(TempDirTestCase):
         self.assertEqual(ours, "exact drive: gamma 1e6 0.002 +/- 0.005, 1e8 0.04 +/- 0.005; "
                                "reset drive: gamma 1e6 0.075 +/- 0.005, 1e8 0.075 +/- 0.005")
         self.assertEqual(verdict, "reproduced under a reading: the reset drive")
+
+    def write_law_studies(self):
+        """IQS and ELAS under both readings of gamma: ELAS +12 % at eta 2 (0.2 d), +88 % at eta 4
+        and stopped at eta 8 (0.02 d); mean |epsilon| ratios 0.8, 2.0 (eta 4), 1.2, 1.5."""
+        law = ["Contact law/Law", "Contact law/Cohesion"]
+        write_shear_study(self.tmp, "laws_cohesion", law, [
+            {"Contact law/Law": "IQS", "Contact law/Cohesion": "0", "mu": 0.115, "eps": 2e-11},
+            {"Contact law/Law": "IQS", "Contact law/Cohesion": "480", "mu": 0.33, "eps": 1e-11, "profile": (0.68, 0.14)},
+            {"Contact law/Law": "IQS", "Contact law/Cohesion": "960", "mu": 0.51, "eps": 1e-11},
+            {"Contact law/Law": "ELAS", "Contact law/Cohesion": "0", "mu": 0.092, "eps": 1.6e-11},
+            {"Contact law/Law": "ELAS", "Contact law/Cohesion": "480", "mu": 0.62, "eps": 2e-11},
+            {"Contact law/Law": "ELAS", "Contact law/Cohesion": "960", "mu": 1.3, "status": "failed",
+             "error": "an overlap of 4.8e-07 m"}])
+        write_shear_study(self.tmp, "laws_cohesion_range", law, [
+            {"Contact law/Law": "IQS", "Contact law/Cohesion": "120", "mu": 0.30, "eps": 1e-11},
+            {"Contact law/Law": "IQS", "Contact law/Cohesion": "240", "mu": 0.48, "eps": 1e-11},
+            {"Contact law/Law": "ELAS", "Contact law/Cohesion": "120", "mu": 0.29, "eps": 1.2e-11},
+            {"Contact law/Law": "ELAS", "Contact law/Cohesion": "240", "mu": 0.5376, "eps": 1.5e-11}])
+
+    def test_the_laws_rows_give_each_reading_its_verdict(self):
+        self.write_law_studies()
+        rows = reproduction_rows(reproduction(self.tmp).stdout)
+        ours, verdict = rows["mu of IQS against ELAS, 0-1 cohesion"]
+        self.assertIn("eta 2: IQS 0.48 +/- 0.002, ELAS 0.5376 +/- 0.002, ratio 1.12 +/- 0.01", ours)
+        self.assertIn("0.02 d: ELAS stops at gamma = 1 (eta 8); with less cohesion it lies +88% to +88% from IQS "
+                      "(not reproduced)", verdict)
+        self.assertIn("0.2 d: at gamma = 1 (eta 2) ELAS +12% +/- 1% (reproduced)", verdict)
+        self.assertIn("at gamma = 0 ELAS -20% +/- 2%", verdict)
+        ours, verdict = rows["epsilon_ELAS / epsilon_IQS"]
+        self.assertIn("0.02 d: eta 0 0.80 +/- 0.00; eta 4 2.00 +/- 0.00. 0.2 d: eta 1 1.20 +/- 0.00; eta 2 1.50", ours)
+        self.assertIn("0.02 d: above 1 with cohesion, growing with eta; 0.2 d: above 1 with cohesion, growing", verdict)
+
+    def test_accommodation_moves_to_the_lower_interface_under_a_soft_body(self):
+        self.write_law_studies()
+        body = ["Shear cell/Upper body Young's modulus", "Contact law/Cohesion"]
+        write_shear_study(self.tmp, "accommodation", body, [
+            {body[0]: "1e11", body[1]: "0", "mu": 0.11}, {body[0]: "3e9", body[1]: "0", "mu": 0.11},
+            {body[0]: "1e11", body[1]: "480", "mu": 0.3, "profile": (0.80, 0.41)},
+            {body[0]: "3e9", body[1]: "480", "mu": 0.3, "profile": (0.58, 0.10)}])
+        ours, verdict = reproduction_rows(reproduction(self.tmp).stdout)[
+            "velocity accommodation with the upper body's stiffness"]
+        self.assertIn("eta 4: rigid 0.32 +/- 0.02 / 0.14 +/- 0.02, E1 0.20 +/- 0.02 / 0.41 +/- 0.02, "
+                      "E2 0.42 +/- 0.02 / 0.10 +/- 0.02", ours)
+        self.assertTrue(verdict.startswith("reproduced under a reading (gamma = 0.5 as eta = 4): the soft body moves "
+                                           "the velocity drop to the lower interface (TB/LB; E2 - E1 +7.8 errors)"),
+                        verdict)
+        # A soft body that changes nothing is not the paper's
+        os.remove(os.path.join(self.tmp, "accommodation", "case_003", "profiles.csv"))
+        with open(os.path.join(self.tmp, "accommodation", "case_003", "profiles.csv"), "w") as f:
+            f.write("layer,y_over_h,vx,vx_stderr\n" + "".join("%d,%r,%r,0.1\n" % (i, (i + 0.5) / 10, 5 * (
+                0.8 if i == 2 else 0.41 if i == 7 else 0.5)) for i in range(10)))
+        verdict = reproduction_rows(reproduction(self.tmp).stdout)[
+            "velocity accommodation with the upper body's stiffness"][1]
+        self.assertTrue(verdict.startswith("not reproduced"), verdict)
 
     def test_a_load_two_errors_off_is_not_reproduced(self):
         write_reference(self.tmp, 100.3, 0.1)
