@@ -5,12 +5,15 @@
 // velocities less the impulses' effect), warm-started as the engine does (each contact from
 // its impulse of the step before) or cold, splits it into bands and solves it on all ranks,
 // and on one rank, to each target. docs/scaling.md records it.
+// With two ranks it first measures a ping-pong between them (the latency and bandwidth that
+// scripts/scaling_model.py takes).
 // Usage: mpirun -np N bench_distributed [CASE.prm] [STEPS] [--set "Section/Entry=value"]...
 #include "bench/bench_case.h"
 #include "dem/parallel/distributed_gauss_seidel.h"
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <map>
@@ -27,6 +30,32 @@ int main(int argc, char **argv)
   const MPI_Comm     world = MPI_COMM_WORLD;
   const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(world);
   const unsigned int n    = dealii::Utilities::MPI::n_mpi_processes(world);
+  if (n == 2)
+    for (const std::size_t bytes : {std::size_t(8), std::size_t(1) << 16})
+      {
+        // Half the round trip of a message of @p bytes, the best of 5 batches of 1000.
+        std::vector<char> buffer(bytes);
+        double            best = 1e300;
+        for (int batch = 0; batch < 5; ++batch)
+          {
+            MPI_Barrier(world);
+            const auto t0 = Clock::now();
+            for (int i = 0; i < 1000; ++i)
+              if (rank == 0)
+                {
+                  MPI_Send(buffer.data(), int(bytes), MPI_CHAR, 1, 0, world);
+                  MPI_Recv(buffer.data(), int(bytes), MPI_CHAR, 1, 0, world, MPI_STATUS_IGNORE);
+                }
+              else
+                {
+                  MPI_Recv(buffer.data(), int(bytes), MPI_CHAR, 0, 0, world, MPI_STATUS_IGNORE);
+                  MPI_Send(buffer.data(), int(bytes), MPI_CHAR, 0, 0, world);
+                }
+            best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count() / 2000);
+          }
+        if (rank == 0)
+          std::printf("ping-pong: %zu bytes in %.2f us one way (%.2f GB/s)\n", bytes, 1e6 * best, bytes / best / 1e9);
+      }
   bench::BenchCase bench_case(argc, argv, "cases/shear/reference_bench_sample.prm");
   const std::string case_file = bench_case.case_file("cases/shear/reference_bench_sample.prm");
   const unsigned    steps     = bench_case.count(1, 50);

@@ -14,11 +14,14 @@
 namespace tribo::dem::parallel
 {
   /// The distributed vector of the grains' velocities, three entries per grain
-  /// (v_x, v_y, spin at 3 g, 3 g + 1, 3 g + 2 for global grain g).
+  /// (v_x, v_y, spin at 3 g, 3 g + 1, 3 g + 2 for global grain g). Its owned entries of the
+  /// exported grains (owned grains that are ghosts on another rank) hold their velocities;
+  /// the other owned entries are never read.
   struct DistributedGaussSeidel::Exchange
   {
     dealii::LinearAlgebra::distributed::Vector<double> v;
-    unsigned int                                        owned_entries = 0, ghost_entries = 0;
+    unsigned int                                        owned_entries = 0;
+    std::vector<unsigned int>                           exported; ///< local numbers of the exported grains
   };
 
   DistributedGaussSeidel::DistributedGaussSeidel(const RankProblem &p, MPI_Comm comm)
@@ -32,9 +35,16 @@ namespace tribo::dem::parallel
       ghosts.add_range(3 * p.global_grain[l], 3 * (p.global_grain[l] + 1));
     owned.compress();
     ghosts.compress();
-    exchange->v.reinit(owned, ghosts, comm);
+    auto &v = exchange->v;
+    v.reinit(owned, ghosts, comm);
     exchange->owned_entries = 3 * p.n_owned;
-    exchange->ghost_entries = 3 * p.n_ghost;
+    // The exported grains: those whose entries a compress of ones on every ghost reaches.
+    for (unsigned int j = 0; j < 3 * p.n_ghost; ++j)
+      v.local_element(exchange->owned_entries + j) = 1;
+    v.compress(dealii::VectorOperation::add);
+    for (unsigned int l = 0; l < p.n_owned; ++l)
+      if (v.local_element(3 * l) != 0)
+        exchange->exported.push_back(l);
   }
 
   DistributedGaussSeidel::~DistributedGaussSeidel() = default;
@@ -56,19 +66,20 @@ namespace tribo::dem::parallel
         for (Contact &c : p.contacts)
           gauss_seidel_update(c, p.state, law, 1.0);
 
-        // Ghost-to-owner: the changes this rank made to ghosts, added by their owners.
-        v = 0.;
+        // Ghost-to-owner: the changes this rank made to ghosts, added by their owners to the
+        // velocities of their exported grains.
+        v.zero_out_ghost_values();
         for (unsigned int j = 0; j < p.n_ghost; ++j)
           for (unsigned int k = 0; k < 3; ++k)
             v.local_element(exchange->owned_entries + 3 * j + k) =
               p.state.velocity[p.n_owned + j][k] - before[j][k];
-        v.compress(dealii::VectorOperation::add);
-        for (unsigned int l = 0; l < p.n_owned; ++l)
+        for (const unsigned int l : exchange->exported)
           for (unsigned int k = 0; k < 3; ++k)
-            {
-              p.state.velocity[l][k] += v.local_element(3 * l + k);
-              v.local_element(3 * l + k) = p.state.velocity[l][k];
-            }
+            v.local_element(3 * l + k) = p.state.velocity[l][k];
+        v.compress(dealii::VectorOperation::add);
+        for (const unsigned int l : exchange->exported)
+          for (unsigned int k = 0; k < 3; ++k)
+            p.state.velocity[l][k] = v.local_element(3 * l + k);
         // Owner-to-ghost.
         v.update_ghost_values();
         for (unsigned int j = 0; j < p.n_ghost; ++j)
