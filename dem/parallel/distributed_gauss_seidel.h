@@ -12,10 +12,18 @@
 /// - the owners' velocities go to the ghosts (owner-to-ghost: update_ghost_values()).
 /// Inside a rank this is the serial Gauss-Seidel sweep; across ranks it is a Jacobi step:
 /// two contacts of different ranks on one grain both act on the velocity the last
-/// exchange left. On one rank it is the serial NLGS sweep in detection order, bit for bit.
+/// exchange left. On one rank, without momentum, it is the serial NLGS sweep in detection
+/// order, bit for bit.
 ///
 /// The stopping test is the law residual (dem/laws/law_residual.h) over all ranks' contacts,
 /// max |phi| over the mean loaded impulse: two reductions every check_interval sweeps.
+///
+/// Without friction the sweeps carry Nesterov's momentum, as APGS's do: y_k+1 = S(z_k),
+/// t_k+1 = (1 + sqrt(1 + 4 t_k^2)) / 2, z_k+1 = y_k+1 + (t_k - 1) / t_k+1 (y_k+1 - y_k), with the
+/// gradient restart t_k = 1 when (z_k - y_k+1).(y_k+1 - y_k) > 0 (weighted by W_nn + c, APGS's
+/// scaled variables): one more sum over the ranks per sweep. The extrapolation's velocity
+/// changes travel with the sweep's in the one exchange per sweep (two on check sweeps, where
+/// the residual is taken at y, before the extrapolation).
 
 #include "dem/laws/contact_law.h"
 #include "dem/parallel/rank_problem.h"
@@ -32,6 +40,16 @@ namespace tribo::dem::parallel
     double       residual_target = 1e-4;  ///< stop below this global relative law residual
     unsigned int max_sweeps      = 10000; ///< then stop, not converged
     unsigned int check_interval  = 10;    ///< sweeps between law-residual checks
+    /// Nesterov's momentum on the sweeps with the gradient restart, as APGS (dem/solvers/apgs.h)
+    /// puts it on its own: on the frictionless law only (with friction the law is not
+    /// associated and plain sweeps are used). Off: the plain NLGS sweep.
+    bool momentum = true;
+    /// With momentum, the relaxation omega (r <- omega r_law + (1 - omega) r) of the contacts
+    /// that touch a grain other ranks' contacts touch too. Their sweeps are Jacobi steps across
+    /// the ranks, and with omega = 1 the momentum amplifies their overshoot until the solve
+    /// diverges (the established code's sample on two ranks); 0.5 halves what two ranks
+    /// put on one grain at once, and the sweeps are then the one-rank count (docs/scaling.md).
+    double interface_relaxation = 0.5;
   };
 
   /// What a distributed solve achieved; the same on every rank.
