@@ -118,7 +118,7 @@ namespace tribo::dem::parallel
     // exported grain): across the ranks their sweeps are Jacobi steps, whose overshoot the
     // momentum amplifies until the solve diverges; with momentum they are relaxed.
     const bool                   momentum = controls.momentum && law.friction <= 0;
-    std::vector<Eigen::Vector2d> y_last, z_start;
+    std::vector<Eigen::Vector2d> y_last;
     std::vector<bool>            shared(n_local, false), interface(p.contacts.size(), false);
     double                       t = 1;
     if (momentum)
@@ -138,14 +138,18 @@ namespace tribo::dem::parallel
     for (unsigned int sweep = 1; sweep <= controls.max_sweeps; ++sweep)
       {
         remember();
-        if (momentum)
-          {
-            z_start.clear();
-            for (const Contact &c : p.contacts)
-              z_start.push_back(c.r);
-          }
+        // The sweep, and with momentum the gradient restart's sum over it: no momentum when the
+        // sweep's step opposes it, (z_k - y_k+1).(y_k+1 - y_k) > 0 in the scaled variables
+        // (weights W_nn + c), z_k a contact's impulse before its local solve, y_k+1 after it.
+        double opposing = 0;
         for (std::size_t i = 0; i < p.contacts.size(); ++i)
-          gauss_seidel_update(p.contacts[i], p.state, law, interface[i] ? controls.interface_relaxation : 1.0);
+          {
+            Contact              &c = p.contacts[i];
+            const Eigen::Vector2d z = c.r;
+            gauss_seidel_update(c, p.state, law, interface[i] ? controls.interface_relaxation : 1.0);
+            if (momentum)
+              opposing += (c.W(0, 0) + c.compliance) * (z - c.r).dot(c.r - y_last[i]);
+          }
         report.sweeps = sweep;
         const bool check = sweep % controls.check_interval == 0 || sweep == controls.max_sweeps;
         if (check)
@@ -160,14 +164,6 @@ namespace tribo::dem::parallel
           }
         if (momentum)
           {
-            // The gradient restart: no momentum when the sweep's step opposes it,
-            // (z_k - y_k+1).(y_k+1 - y_k) > 0 in the scaled variables (weights W_nn + c).
-            double opposing = 0;
-            for (std::size_t i = 0; i < p.contacts.size(); ++i)
-              {
-                const Contact &c = p.contacts[i];
-                opposing += (c.W(0, 0) + c.compliance) * (z_start[i] - c.r).dot(c.r - y_last[i]);
-              }
             if (dealii::Utilities::MPI::sum(opposing, comm) > 0)
               t = 1;
             const double t_next = 0.5 * (1 + std::sqrt(1 + 4 * t * t));
