@@ -120,6 +120,11 @@ int main(int argc, char **argv)
           return std::make_tuple(report, dealii::Utilities::MPI::max(t, comm),
                                  dealii::Utilities::MPI::sum(double(share.n_ghost), comm));
         };
+        // Rank 0's counters per sweep.
+        auto traffic = [](const dem::parallel::DistributedReport &r) {
+          return std::make_tuple(double(r.bytes_sent) / r.sweeps, double(r.exchanges) / r.sweeps,
+                                 double(r.reductions) / r.sweeps, r.neighbours);
+        };
         // The engine's serial APGS on one core, to the same law residual.
         dem::SolverParameters apgs = p.solver;
         apgs.method                = dem::SolverParameters::Method::apgs;
@@ -135,6 +140,10 @@ int main(int argc, char **argv)
             const auto [serial, serial_time, unused] = solve_on(MPI_COMM_SELF, momentum);
             const auto [here, here_time, ghosts]     = solve_on(world, momentum);
             (void)unused;
+            const auto [bytes, exchanges, reductions, neighbours] = traffic(here);
+            if (rank == 0 && n > 1)
+              std::printf("  rank 0 per sweep: %.0f bytes sent, %.2f exchanges with %u neighbours, %.2f sums over the ranks\n",
+                          bytes, exchanges, neighbours, reductions);
             if (rank == 0)
               std::printf("%s, target %g, %s: %u ranks %u sweeps (law residual %.2e) in %.4f s, one rank %u sweeps "
                           "in %.4f s (sweeps x %.3f, T1 / (N TN) %.2f), %.0f ghosts; APGS one core %u iterations "

@@ -67,7 +67,17 @@ namespace tribo::dem::parallel
     // After local changes since remember(): ghost-to-owner (the changes this rank made to
     // ghosts, added by their owners to their exported grains), owner-to-ghost, and the
     // replicated bodies' changes summed over the ranks.
+    const auto                  &partitioner = *v.get_partitioner();
+    std::vector<unsigned int>    peers;
+    for (const auto &target : partitioner.ghost_targets())
+      peers.push_back(target.first);
+    for (const auto &target : partitioner.import_targets())
+      peers.push_back(target.first);
+    std::sort(peers.begin(), peers.end());
+    report.neighbours = static_cast<unsigned int>(std::unique(peers.begin(), peers.end()) - peers.begin());
     const auto exchange_changes = [&] {
+      ++report.exchanges;
+      report.bytes_sent += sizeof(double) * (partitioner.n_ghost_indices() + partitioner.n_import_indices());
       v.zero_out_ghost_values();
       for (unsigned int j = 0; j < p.n_ghost; ++j)
         for (unsigned int k = 0; k < 3; ++k)
@@ -85,6 +95,7 @@ namespace tribo::dem::parallel
           p.state.velocity[p.n_owned + j][k] = v.local_element(exchange->owned_entries + 3 * j + k);
       if (n_rep > 0)
         {
+          ++report.reductions;
           for (unsigned int j = 0; j < n_rep; ++j)
             for (unsigned int k = 0; k < 3; ++k)
               wall_change[3 * j + k] = p.state.velocity[first_rep + j][k] - before[p.n_ghost + j][k];
@@ -100,6 +111,7 @@ namespace tribo::dem::parallel
     // (maxima), the loaded impulses' sum and count (sums). True when below the target.
     const auto converged = [&] {
       ++report.checks;
+      report.reductions += 2;
       const LawResidual local     = law_residual(p.contacts, p.state, law, theta_h);
       const double      loaded[2] = {local.mean_impulse * local.loaded, double(local.loaded)};
       const double      maxima[2] = {local.max_phi, local.gap_violation};
@@ -164,6 +176,7 @@ namespace tribo::dem::parallel
           }
         if (momentum)
           {
+            ++report.reductions;
             if (dealii::Utilities::MPI::sum(opposing, comm) > 0)
               t = 1;
             const double t_next = 0.5 * (1 + std::sqrt(1 + 4 * t * t));

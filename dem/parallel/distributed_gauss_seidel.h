@@ -60,6 +60,13 @@ namespace tribo::dem::parallel
     double       law_residual  = 0; ///< over every rank's contacts at the last check
     double       gap_violation = 0; ///< theta h max(0, -(u_n + b)) over every IQS contact, m
     bool         converged     = false;
+    /// This rank's traffic over the solve: exchanges (each two messages to every neighbour,
+    /// ghost-to-owner and owner-to-ghost), the bytes it sent in them, and the sums over all
+    /// ranks it took part in (the walls', the momentum's restart, the stopping test's).
+    unsigned int  exchanges  = 0;
+    std::uint64_t bytes_sent = 0;
+    unsigned int  reductions = 0;
+    unsigned int  neighbours = 0; ///< ranks it exchanges with
   };
 
   class DistributedGaussSeidel

@@ -253,6 +253,16 @@ namespace
               << ", worst velocity difference " << worst << " m/s, upper wall impulse " << here.wall_impulse.transpose()
               << " against serial " << serial_impulse.transpose() << " N s/m" << std::endl;
     EXPECT_LE(here.report.sweeps, 2 * plain.report.sweeps);
+    // The counters: bands have one neighbour at the ends, two inside; every exchange sums the
+    // walls' changes, every check two figures; nothing travels on one rank.
+    const DistributedReport &r = here.report;
+    EXPECT_EQ(r.neighbours, n_ranks() == 1 ? 0u : my_rank() == 0 || my_rank() + 1 == n_ranks() ? 1u : 2u);
+    EXPECT_GE(r.exchanges, r.sweeps);
+    EXPECT_EQ(r.bytes_sent == 0, n_ranks() == 1);
+    if (cold.law.friction > 0) // plain sweeps: no restart sums
+      {
+        EXPECT_EQ(r.reductions, r.exchanges + 2 * r.checks);
+      }
     if (cold.law.friction <= 0) // the momentum still pays across ranks
       {
         EXPECT_LT(here.report.sweeps, plain.report.sweeps);
