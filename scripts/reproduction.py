@@ -27,6 +27,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from study_stderr import batch_means, mean_stderr  # noqa: E402
+
 MPA = 1e6
 CAO = "Cao et al. 2011"
 MAVEYRAUD = "Maveyraud et al. 1999"
@@ -91,13 +94,17 @@ def profile_linearity(directory):
     return float(np.sqrt(np.mean((fit - v) ** 2))), (v[0] - v[2]) / drop, (v[-3] - v[-1]) / drop
 
 
-def mean_epsilon_over_radius(directory, mean_radius=0.6e-6):
-    """Mean |epsilon| (Cao et al. eq. 13) over the averaging window, over the mean radius."""
+def window_epsilon(directory):
+    """|epsilon| (Cao et al. eq. 13, m) of every statistics row in the averaging window, in time order."""
     with open(os.path.join(directory, "summary.json")) as f:
         start = json.load(f)["results"]["averaging_start"]
     with open(os.path.join(directory, "statistics.csv")) as f:
-        eps = [abs(float(r["epsilon"])) for r in csv.DictReader(f) if float(r["time"]) >= start]
-    return float(np.mean(eps)) / mean_radius
+        return [abs(float(r["epsilon"])) for r in csv.DictReader(f) if float(r["time"]) >= start]
+
+
+def mean_epsilon_over_radius(directory, mean_radius=0.6e-6):
+    """Mean |epsilon| over the averaging window, over the mean radius."""
+    return float(np.mean(window_epsilon(directory))) / mean_radius
 
 
 def row_sigma_xy_without_cohesion(runs):
@@ -287,19 +294,10 @@ def row_laws(runs):
     return "mu, ELAS (k = 1e10 N/m^2) against IQS, APGS 1e-3. " + ". ".join(parts), verdict
 
 
-def batch_mean_se(values, batches=10):
-    """Mean and batch-means standard error of @p values in time order (scripts/study_stderr.py)."""
-    means = np.array([b.mean() for b in np.array_split(np.asarray(values), batches)])
-    return float(means.mean()), float(means.std(ddof=1) / np.sqrt(batches))
-
-
 def epsilon_batches(directory):
-    """Mean |epsilon| over the averaging window and its standard error, m."""
-    with open(os.path.join(directory, "summary.json")) as f:
-        start = json.load(f)["results"]["averaging_start"]
-    with open(os.path.join(directory, "statistics.csv")) as f:
-        eps = [abs(float(r["epsilon"])) for r in csv.DictReader(f) if float(r["time"]) >= start]
-    return batch_mean_se(eps)
+    """Mean |epsilon| over the averaging window and its batch-means standard error, m."""
+    mean, se = mean_stderr(batch_means(window_epsilon(directory)))
+    return float(mean), float(se)
 
 
 def row_epsilon_laws(runs):
