@@ -19,10 +19,12 @@ namespace tribo::dem
     v.x() += im[0] * f.x();
     v.y() += im[1] * f.y();
     v.z() += im[2] * (c.arm_n[1] * dr.x() + c.arm_t[1] * dr.y());
-    // The nodes receive -J_A^T f and -J_B^T f: two column pairs of the compliance.
-    const Eigen::MatrixXd &G = *node_compliance;
+    // The nodes receive -J_A^T f and -J_B^T f: two column pairs of their body's compliance.
+    const NodeBlock       &block = node_blocks[c.boundary_body];
+    const Eigen::MatrixXd &G     = *block.compliance;
     for (int k = 0; k < 2; ++k)
-      node_velocity.noalias() -= G.middleCols<2>(2 * c.node[k]) * (c.node_map[k].transpose() * f);
+      node_velocity.segment(2 * block.first_node, G.rows()).noalias() -=
+        G.middleCols<2>(2 * (c.node[k] - block.first_node)) * (c.node_map[k].transpose() * f);
   }
 
   Eigen::Matrix2d BodyState::delassus_block(const Contact &c) const
@@ -41,7 +43,7 @@ namespace tribo::dem
         Eigen::Matrix4d G;
         for (int a = 0; a < 2; ++a)
           for (int b = 0; b < 2; ++b)
-            G.block<2, 2>(2 * a, 2 * b) = node_compliance->block<2, 2>(2 * c.node[a], 2 * c.node[b]);
+            G.block<2, 2>(2 * a, 2 * b) = node_compliance(c.boundary_body, c.node[a], c.node[b]);
         W = B.transpose() * G * B;
       }
     for (int s = c.on_boundary() ? 1 : 0; s < 2; ++s)

@@ -19,10 +19,27 @@ namespace tribo::dem
   {
     std::vector<Eigen::Vector3d>       velocity;
     std::vector<std::array<double, 3>> inverse_mass;
-    /// Velocities of the boundary nodes of a BoundaryBody (2n: x, y per node), m/s,
-    /// and its compliance (dem/engine/boundary.h); empty / null without one.
-    Eigen::VectorXd        node_velocity;
-    const Eigen::MatrixXd *node_compliance = nullptr;
+    /// Velocities of the boundary nodes of the attached BoundaryBody's (dem/engine/boundary.h),
+    /// the bodies' nodes one after another (2 per node: x, y), m/s; empty without one.
+    Eigen::VectorXd node_velocity;
+    /// Where one BoundaryBody's nodes are in node_velocity: from node @p first_node on, as
+    /// many as its compliance G has node pairs of rows (2n x 2n, m/s per N s/m). Two bodies'
+    /// nodes are coupled only through the grains, so the compliance of all the nodes over a
+    /// step is block-diagonal, one block per body: Contact::boundary_body indexes them.
+    struct NodeBlock
+    {
+      unsigned int           first_node = 0;
+      const Eigen::MatrixXd *compliance = nullptr;
+    };
+    std::vector<NodeBlock> node_blocks;
+
+    /// The 2x2 compliance between nodes @p a and @p b (indices into node_velocity's nodes) of
+    /// boundary body @p body: the velocity change of node a per unit impulse on node b.
+    Eigen::Matrix2d node_compliance(unsigned int body, unsigned int a, unsigned int b) const
+    {
+      const NodeBlock &block = node_blocks[body];
+      return block.compliance->block<2, 2>(2 * (a - block.first_node), 2 * (b - block.first_node));
+    }
 
     /// The current velocities and inverse masses of @p system's bodies (no boundary body).
     static BodyState of(const ParticleSystem &system)

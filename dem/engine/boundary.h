@@ -6,7 +6,9 @@
 /// their positions and velocities at the start of a step, their free velocities
 /// (no contact impulse), and the compliance that maps node impulses to node
 /// velocity changes. A deal.II body (fem/), an SPH or an MLP body implements it; the
-/// rigid clumps stay in ParticleSystem, where their compliance is closed form.
+/// rigid clumps stay in ParticleSystem, where their compliance is closed form. Any number
+/// of such bodies can be attached to one MoreauJean (an upper and a lower first body);
+/// within a step each body's nodes couple only through its own compliance.
 ///
 /// Hybrid half-disc elements (Cao et al. 2011, section 2.1 and Fig. 4): rigid
 /// half-discs of diameter D with their flat side on the chain and their round side

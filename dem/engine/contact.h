@@ -29,12 +29,15 @@ namespace tribo::dem
     double cohesion_impulse = 0, shift = 0, compliance = 0; ///< law terms (ContactLaw::Terms)
     /// Against a half-disc element of a BoundaryBody (dem/engine/boundary.h): its index, else -1.
     /// Side 0 is then the half-disc, a rigid body carried by the chain edge that holds
-    /// its anchor (nodes node[0] = A, node[1] = B). The velocity of its material point at
+    /// its anchor (nodes node[0] = A, node[1] = B) of boundary body @p boundary_body. With
+    /// several bodies attached to a MoreauJean, their half-discs and nodes are numbered one
+    /// body after another (BodyState::node_blocks). The velocity of its material point at
     /// the contact point is v_P = J_A v_A + J_B v_B with J = node_map (2x2, the centre's
     /// interpolation plus the edge's rotation, dem/engine/boundary.h); an impulse r on the grain
     /// puts -J_A^T f and -J_B^T f (f = r_n n + r_t t) on the nodes. body[0] and the
     /// side-0 arms are unused.
     int             half_disc = -1;
+    unsigned int    boundary_body = 0;
     unsigned int    node[2]   = {0, 0};
     Eigen::Matrix2d node_map[2] = {Eigen::Matrix2d::Zero(), Eigen::Matrix2d::Zero()};
 

@@ -26,8 +26,12 @@ namespace tribo::dem
   void MoreauJean::attach(BoundaryBody &body, double half_disc_diameter, const Vec2 &outward,
                           double period)
   {
-    boundary = &body;
-    half_discs = std::make_unique<HalfDiscs>(body, half_disc_diameter, outward, period);
+    auto               half_discs = std::make_unique<HalfDiscs>(body, half_disc_diameter, outward, period);
+    const unsigned int first_half_disc =
+      attached.empty() ? 0 : attached.back().first_half_disc + attached.back().half_discs->count();
+    attached.push_back({&body, std::move(half_discs), n_nodes, first_half_disc});
+    n_nodes += body.n_nodes();
+    state.node_blocks.push_back({attached.back().first_node, nullptr});
   }
 
   namespace
@@ -73,8 +77,8 @@ namespace tribo::dem
     sum_contact_forces(h);
     const auto fastest = update_bodies(system, h, report);
     report.max_speed   = fastest.first;
-    if (boundary)
-      update_boundary_body(h, report);
+    if (!attached.empty())
+      update_boundary_bodies(h, report);
     compute_contact_powers(h);
     check_overlaps(system, h, report, deepest_overlap, fastest);
     report.kinetic_energy = system.kinetic_energy();
@@ -136,28 +140,39 @@ namespace tribo::dem
     detector.detect(system, centres, distance, solver->parameters().threads, disc_motion, found);
     report.time_detection      = seconds_since(phase);
 
-    // The boundary body: free state, predicted nodes, half-disc contacts.
-    if (boundary)
+    // The boundary bodies: free states, predicted nodes, half-disc contacts, each body's
+    // nodes and half-discs numbered after the previous bodies'.
+    node_v_begin.resize(n_nodes);
+    state.node_velocity.resize(2 * n_nodes);
+    for (std::size_t k = 0; k < attached.size(); ++k)
       {
-        const unsigned int nn = boundary->n_nodes();
+        BoundaryBody      &body = *attached[k].body;
+        const unsigned int nn = body.n_nodes(), first = attached[k].first_node;
         phase                 = std::chrono::steady_clock::now();
-        boundary->predict(h);
-        report.time_boundary_body = seconds_since(phase);
+        body.predict(h);
+        report.time_boundary_body += seconds_since(phase);
         std::vector<Vec2> nodes(nn), node_motion(nn);
-        node_v_begin.resize(nn);
-        state.node_velocity.resize(2 * nn);
         for (unsigned int i = 0; i < nn; ++i)
           {
-            node_v_begin[i] = boundary->node_velocity(i);
-            nodes[i]        = boundary->node_position(i) + (1 - th) * h * node_v_begin[i];
-            node_motion[i]  = lookahead * h * node_v_begin[i]; // as the discs' motions
-            state.node_velocity.segment<2>(2 * i) = boundary->node_free_velocity(i);
+            const Vec2 v = body.node_velocity(i);
+            node_v_begin[first + i] = v;
+            nodes[i]                = body.node_position(i) + (1 - th) * h * v;
+            node_motion[i]          = lookahead * h * v; // as the discs' motions
+            state.node_velocity.segment<2>(2 * (first + i)) = body.node_free_velocity(i);
           }
-        state.node_compliance = &boundary->compliance();
+        state.node_blocks[k].compliance = &body.compliance();
         phase            = std::chrono::steady_clock::now();
-        auto on_boundary = half_discs->detect(system, centres, angle_pred, nodes, distance, disc_motion, node_motion);
+        auto on_boundary = attached[k].half_discs->detect(system, centres, angle_pred, nodes, distance, disc_motion,
+                                                          node_motion);
         report.time_detection += seconds_since(phase);
-        report.n_boundary_contacts = on_boundary.size();
+        report.n_boundary_contacts += on_boundary.size();
+        for (Contact &c : on_boundary)
+          {
+            c.boundary_body = k;
+            c.half_disc += attached[k].first_half_disc;
+            c.node[0] += first;
+            c.node[1] += first;
+          }
         found.insert(found.end(), on_boundary.begin(), on_boundary.end());
       }
   }
@@ -236,8 +251,7 @@ namespace tribo::dem
     // Contact force on every body over the step.
     const std::size_t nb = state.velocity.size();
     body_force.assign(nb, Eigen::Vector3d::Zero());
-    if (boundary)
-      node_impulse.assign(boundary->n_nodes(), Vec2::Zero());
+    node_impulse.assign(n_nodes, Vec2::Zero());
     for (const Contact &c : current)
       {
         const Vec2 t(-c.normal.y(), c.normal.x());
@@ -307,27 +321,33 @@ namespace tribo::dem
     return fastest;
   }
 
-  void MoreauJean::update_boundary_body(double h, StepReport &report)
+  void MoreauJean::update_boundary_bodies(double h, StepReport &report)
   {
-    // The deformable body takes the contact impulses on its nodes; its end velocities
+    // Each deformable body takes the contact impulses on its nodes; its end velocities
     // give the nodes' share of the contact power.
-    const unsigned int nn = boundary->n_nodes();
     if (!state.node_velocity.allFinite())
-      throw RunError("the boundary body's nodes have non-finite velocities: the solver diverged");
-    const auto phase = std::chrono::steady_clock::now();
-    boundary->finalize(node_impulse);
-    report.time_boundary_body += seconds_since(phase);
-    // With the body's own end velocities (not the solver's running copy, which
-    // carries the round-off of many incremental updates), the balance is exact.
-    for (unsigned int i = 0; i < nn; ++i)
+      throw RunError("a boundary body's nodes have non-finite velocities: the solver diverged");
+    node_v_end.resize(n_nodes);
+    for (const Attached &a : attached)
       {
-        const Vec2 v_mid = 0.5 * (node_v_begin[i] + boundary->node_velocity(i));
-        report.power_contacts += node_impulse[i].dot(v_mid) / h;
+        BoundaryBody      &body = *a.body;
+        const unsigned int nn   = body.n_nodes();
+        const auto         phase = std::chrono::steady_clock::now();
+        body.finalize(std::vector<Vec2>(node_impulse.begin() + a.first_node, node_impulse.begin() + a.first_node + nn));
+        report.time_boundary_body += seconds_since(phase);
+        // With the body's own end velocities (not the solver's running copy, which
+        // carries the round-off of many incremental updates), the balance is exact.
+        for (unsigned int i = 0; i < nn; ++i)
+          {
+            const unsigned int node = a.first_node + i;
+            node_v_end[node]        = body.node_velocity(i);
+            report.power_contacts += node_impulse[node].dot(0.5 * (node_v_begin[node] + node_v_end[node])) / h;
+          }
+        report.power_contacts += body.impulse_extra_power();
+        report.power_external += body.external_power();
+        report.boundary_energy += body.energy();
+        report.boundary_dissipation += body.internal_dissipation();
       }
-    report.power_contacts += boundary->impulse_extra_power();
-    report.power_external += boundary->external_power();
-    report.boundary_energy      = boundary->energy();
-    report.boundary_dissipation = boundary->internal_dissipation();
   }
 
   void MoreauJean::compute_contact_powers(double h)
@@ -347,8 +367,7 @@ namespace tribo::dem
               {
                 Vec2 v_point = Vec2::Zero();
                 for (int k = 0; k < 2; ++k)
-                  v_point += c.node_map[k] *
-                             (0.5 * (node_v_begin[c.node[k]] + boundary->node_velocity(c.node[k])));
+                  v_point += c.node_map[k] * (0.5 * (node_v_begin[c.node[k]] + node_v_end[c.node[k]]));
                 u -= Eigen::Vector2d(c.normal.dot(v_point), t.dot(v_point));
                 continue;
               }
@@ -371,9 +390,8 @@ namespace tribo::dem
     if (r_min > 0 && deepest_overlap > r_min)
       {
         double fastest_node = 0;
-        if (boundary)
-          for (unsigned int i = 0; i < boundary->n_nodes(); ++i)
-            fastest_node = std::max(fastest_node, boundary->node_velocity(i).norm());
+        for (const Vec2 &v : node_v_end)
+          fastest_node = std::max(fastest_node, v.norm());
         const double speed = std::max(fastest.first, fastest_node);
         const bool         by_nlgs = report.solver.solved_by_nlgs;
         std::ostringstream os;
@@ -384,7 +402,7 @@ namespace tribo::dem
         if (speed * h > 0.25 * r_min)
           os << "The fastest mover, "
              << (fastest.first >= fastest_node ? "body " + std::to_string(fastest.second)
-                                               : std::string("a node of the deformable upper body"))
+                                               : std::string("a node of a deformable first body"))
              << ", moved " << speed * h << " m in the step (" << speed << " m/s); a step of at most "
              << 0.25 * r_min / speed << " s keeps it within a quarter of the smallest radius";
         else
@@ -399,8 +417,9 @@ namespace tribo::dem
                << ", or set " << contact_law.section.entry("Overlap recovery")
                << "); with ELAS, a stiffness too low for the load (docs/laws.md)";
           }
-        if (const std::string hint = boundary ? boundary->overlap_hint(h) : std::string(); !hint.empty())
-          os << ". " << hint;
+        for (const Attached &a : attached)
+          if (const std::string hint = a.body->overlap_hint(h); !hint.empty())
+            os << ". " << hint;
         throw RunError(os.str());
       }
   }

@@ -10,7 +10,7 @@
 /// the previous step's contact between the same two discs.
 /// MoreauJean::step() runs these as named phases, in this order: predict(), detect(),
 /// set_up_local_problems(), the contact solve and assess_solve(), measure_gaps(),
-/// sum_contact_forces(), update_bodies(), update_boundary_body() (with a deformable body),
+/// sum_contact_forces(), update_bodies(), update_boundary_bodies() (with deformable bodies),
 /// compute_contact_powers(), check_overlaps().
 
 #include "dem/solvers/active_set.h"
@@ -54,14 +54,14 @@ namespace tribo::dem
     double power_free = 0;
     /// Power of the contact forces on all bodies, W/m (<= 0: dissipation).
     double power_contacts = 0;
-    /// With a BoundaryBody: its energy (kinetic + elastic) after the step, J/m, and the
-    /// power dissipated inside it over the step, W/m. Then KE_{i+1} + E_{i+1} - KE_i - E_i
-    /// = h (power_external + power_contacts - boundary_dissipation).
+    /// With BoundaryBody's attached: their energy (kinetic + elastic) after the step, J/m, and
+    /// the power dissipated inside them over the step, W/m, summed over the bodies. Then
+    /// KE_{i+1} + E_{i+1} - KE_i - E_i = h (power_external + power_contacts - boundary_dissipation).
     double boundary_energy      = 0;
     double boundary_dissipation = 0;
-    unsigned int n_boundary_contacts = 0; ///< contacts with half-disc elements
+    unsigned int n_boundary_contacts = 0; ///< contacts with half-disc elements, every body's
     /// Wall time of the step and of its phases, s: detection (disc pairs and half-discs),
-    /// the boundary body's own work (its free state in predict() and its update in
+    /// the boundary bodies' own work (their free state in predict() and their update in
     /// finalize()), and the NLGS solve; the rest is setting up the local problems and
     /// the update of the discs.
     double time_step = 0, time_detection = 0, time_boundary_body = 0, time_solver = 0;
@@ -109,9 +109,15 @@ namespace tribo::dem
     /// Couple @p body (not owned; it must outlive this) to the discs through half-disc
     /// elements of diameter @p half_disc_diameter (m) facing @p outward, periodic with
     /// the system's period (dem/engine/boundary.h). Its loads, energy and power join the step's.
+    /// Any number of bodies may be attached (an upper and a lower first body): the engine
+    /// sees each through this one interface, numbers their nodes and half-discs one body
+    /// after another in the order of attachment (a resumed run attaches them in the same
+    /// order), and their compliances form the blocks of BodyState::node_blocks.
     void attach(BoundaryBody &body, double half_disc_diameter, const Vec2 &outward, double period);
+    /// The attached bodies, in the order of attachment.
+    unsigned int n_boundary_bodies() const { return attached.size(); }
 
-    /// Advance @p system (and the attached boundary body) by one step @p h (s).
+    /// Advance @p system (and the attached boundary bodies) by one step @p h (s).
     StepReport step(ParticleSystem &system, double h);
 
     /// Contacts of the last step with their impulses (N s/m).
@@ -137,7 +143,7 @@ namespace tribo::dem
     static constexpr double lookahead = 2;
 
     /// Checkpoint: the impulses of the last step (the next step's warm start) and the
-    /// solver's random state. The attached boundary body saves its own state.
+    /// solver's random state. The attached boundary bodies save their own states.
     void save(CheckpointOut &ar) const;
     void load(CheckpointIn &ar);
 
@@ -151,8 +157,8 @@ namespace tribo::dem
     /// Free velocities v_free = v + h M^-1 F_ext and the predicted configuration
     /// x + (1 - theta) h v (x_pred, angle_pred), into state and the scratch below.
     void predict(const ParticleSystem &system, double h);
-    /// Disc pairs, and the half-discs of an attached boundary body (after its own
-    /// prediction), closer than the detection distance at the predicted configuration, into found.
+    /// Disc pairs, and the half-discs of the attached boundary bodies (after their own
+    /// predictions), closer than the detection distance at the predicted configuration, into found.
     void detect(const ParticleSystem &system, double h, StepReport &report);
     /// The local problems of found into current: arms (rows of H), own Delassus blocks,
     /// law terms, free local velocities, warm-start impulses applied to state.
@@ -160,13 +166,13 @@ namespace tribo::dem
     /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
     /// (returned, m); stores the loaded contacts' impulses as the next warm start.
     double measure_gaps(double h, StepReport &report);
-    /// body_force (and node_impulse) from the contacts' impulses.
+    /// body_force (and node_impulse, every attached body's nodes) from the contacts' impulses.
     void sum_contact_forces(double h);
     /// End velocities v_free + h M^-1 F_c, positions x_pred + theta h v, powers; returns the
     /// fastest body's speed (m/s) and index. Throws RunError on a non-finite velocity.
     std::pair<double, std::size_t> update_bodies(ParticleSystem &system, double h, StepReport &report);
-    /// The boundary body's update with its node impulses, and its powers and energies.
-    void update_boundary_body(double h, StepReport &report);
+    /// Each boundary body's update with its node impulses, and their powers and energies.
+    void update_boundary_bodies(double h, StepReport &report);
     /// power_of_contact at the mid-step velocities.
     void compute_contact_powers(double h);
     /// RunError when an overlap exceeds the smallest radius, naming the likely cause.
@@ -187,14 +193,23 @@ namespace tribo::dem
     std::vector<double>          body_power;
     std::vector<double>          power_of_contact;
     std::vector<Vec2>        centres;
-    BoundaryBody               *boundary = nullptr;
-    std::unique_ptr<HalfDiscs>  half_discs;
-    std::vector<Vec2>           node_impulse;
+    /// An attached first body, with where its nodes and half-discs begin in the numbering
+    /// of all the attached bodies' (Contact::node, Contact::half_disc).
+    struct Attached
+    {
+      BoundaryBody              *body;
+      std::unique_ptr<HalfDiscs> half_discs;
+      unsigned int               first_node, first_half_disc;
+    };
+    std::vector<Attached>       attached;
+    unsigned int                n_nodes = 0;  ///< of all the attached bodies
+    std::vector<Vec2>           node_impulse; ///< N s/m, per node of all the attached bodies
     // Scratch of one step, between its phases.
     std::vector<Eigen::Vector3d> v_begin, v_free, v_mid_of; ///< (vx, vy, spin) per body
     std::vector<Vec2>            x_pred;                    ///< predicted positions, m
     std::vector<Vec2>            disc_motion;               ///< lookahead h v per disc, m (detect())
     std::vector<double>          angle_pred;                ///< predicted angles, rad
     std::vector<Vec2>            node_v_begin;              ///< boundary nodes' velocities at the start
+    std::vector<Vec2>            node_v_end;                ///< and at the end (the bodies' own)
   };
 } // namespace tribo::dem

@@ -110,10 +110,10 @@ namespace tribo::dem
           }
       }
 
-    // The boundary body: B_i^T G B_j over every pair of half-disc contacts.
+    // The boundary bodies: B_i^T G B_j over every pair of half-disc contacts on one body
+    // (two bodies' nodes do not share a compliance block).
     if (!on_boundary.empty())
       {
-        const Eigen::MatrixXd &G = *state.node_compliance;
         std::vector<Eigen::Matrix<double, 4, 2>> B;
         for (const unsigned int i : on_boundary)
           B.push_back(node_map(contacts[i]));
@@ -121,10 +121,12 @@ namespace tribo::dem
           for (std::size_t q = 0; q < on_boundary.size(); ++q)
             {
               const Contact &ci = contacts[on_boundary[p]], &cj = contacts[on_boundary[q]];
+              if (ci.boundary_body != cj.boundary_body)
+                continue;
               Eigen::Matrix4d g;
               for (int a = 0; a < 2; ++a)
                 for (int b = 0; b < 2; ++b)
-                  g.block<2, 2>(2 * a, 2 * b) = G.block<2, 2>(2 * ci.node[a], 2 * cj.node[b]);
+                  g.block<2, 2>(2 * a, 2 * b) = state.node_compliance(ci.boundary_body, ci.node[a], cj.node[b]);
               add_block(on_boundary[p], on_boundary[q], B[p].transpose() * g * B[q]);
             }
       }

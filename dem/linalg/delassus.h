@@ -3,12 +3,12 @@
 ///
 /// Contact i's local velocity is u_i = sum_j W_ij r_j + u_free,i, with 2x2 blocks
 ///     W_ij = sum over the bodies b that i and j share of s_ib s_jb H_ib^T M_b^-1 H_jb
-///          + B_i^T G_AB B_j                      (both against the boundary body),
+///          + B_i^T G_AB B_j                      (both against one boundary body),
 /// where H_ib^T = [n^T, arm_n; t^T, arm_t] maps body b's velocity (v_x, v_y, spin) to the
 /// local frame of i, s_ib = -1 for side 0 and +1 for side 1, M_b^-1 the inverse masses
 /// (0 for imposed dofs), and for half-disc contacts B_i the 4x2 map from (r_n, r_t) to the
-/// impulses -J_A^T f, -J_B^T f on the edge's two nodes, G_AB the boundary body's
-/// compliance between those nodes (dem/engine/boundary.h). Units: m/s per N s/m. Periodic
+/// impulses -J_A^T f, -J_B^T f on the edge's two nodes, G_AB that body's compliance
+/// between those nodes (dem/engine/boundary.h; zero between two bodies' nodes). Units: m/s per N s/m. Periodic
 /// contacts need nothing special: their arms already use the periodic image.
 /// W_ii is the contact's own block (BodyState::delassus_block).
 ///

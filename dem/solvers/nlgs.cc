@@ -138,7 +138,8 @@ namespace tribo::dem
   namespace
   {
     /// Whether the bands [begin[k], begin[k+1]) of each phase (k even, k odd) touch
-    /// disjoint bodies, the boundary body's nodes counting as one more body.
+    /// disjoint bodies, the boundary bodies' nodes counting as one more body (all of them:
+    /// a body's compliance couples all its nodes).
     bool bands_independent(const std::vector<Contact> &contacts, const std::vector<unsigned int> &begin,
                            std::size_t n_bodies)
     {

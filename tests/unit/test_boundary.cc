@@ -2,6 +2,7 @@
 // against a chain of lumped point masses whose compliance is diagonal.
 #include "dem/engine/boundary.h"
 #include "dem/engine/moreau_jean.h"
+#include "dem/linalg/delassus.h"
 
 #include <gtest/gtest.h>
 
@@ -287,7 +288,7 @@ TEST(HalfDiscs, VelocityMapIsTheTransposeOfTheForceMap)
       vel.inverse_mass    = {{{1, 1, 1}}};
       vel.node_velocity   = Eigen::VectorXd::NullaryExpr(2 * n, [&]() { return U(gen); });
       Eigen::MatrixXd I   = Eigen::MatrixXd::Identity(2 * n, 2 * n);
-      vel.node_compliance = &I;
+      vel.node_blocks     = {{0, &I}};
       const Eigen::Vector2d u = vel.local_velocity(c);
       // H r: with unit inverse masses and compliance, apply_impulse adds H r to zero velocities.
       const Eigen::Vector2d rr(U(gen), U(gen));
@@ -295,7 +296,7 @@ TEST(HalfDiscs, VelocityMapIsTheTransposeOfTheForceMap)
       imp.velocity        = {Eigen::Vector3d::Zero()};
       imp.inverse_mass    = {{{1, 1, 1}}};
       imp.node_velocity   = Eigen::VectorXd::Zero(2 * n);
-      imp.node_compliance = &I;
+      imp.node_blocks     = {{0, &I}};
       imp.apply_impulse(c, rr);
       const double lhs = u.dot(rr);
       const double rhs = vel.velocity[0].dot(imp.velocity[0]) + vel.node_velocity.dot(imp.node_velocity);
@@ -383,4 +384,137 @@ TEST(HalfDiscs, EnergyBalanceWithABoundaryBodyClosesEveryStep)
       touched += rep.n_boundary_contacts > 0;
     }
   EXPECT_GT(touched, 100u);
+}
+
+namespace
+{
+  /// Grains in three rows between a lower chain (half-discs facing up, loaded up) and an
+  /// upper chain (facing down, loaded down), both free point masses: two first bodies
+  /// attached to one MoreauJean, squeezing the layer from both sides.
+  struct TwoBodies
+  {
+    ParticleSystem s;
+    LumpedChain    lower{8, L, 0.0, 2e-8, {0, 100.0}}, upper{8, L, 4.2 * l, 2e-8, {0, -100.0}};
+    MoreauJean     mj;
+
+    explicit TwoBodies(const SolverParameters &prm)
+      : mj(0.5, ContactLaw{}, prm, 5e-8)
+    {
+      s.period = L;
+      for (int i = 0; i < 24; ++i)
+        s.add_disc({(i % 8 + 0.5 + 0.3 * (i / 8 % 2)) * l, (1.05 + 1.05 * (i / 8)) * l}, 0.5e-6, rho);
+      s.bodies[3].velocity = {0.5, -0.2}; // something to dissipate besides the squeeze
+      mj.attach(lower, l, {0, 1}, L);
+      mj.attach(upper, l, {0, -1}, L);
+    }
+    Vec2 grain_momentum() const
+    {
+      Vec2 p = Vec2::Zero();
+      for (const auto &b : s.bodies)
+        p += b.mass * b.velocity;
+      return p;
+    }
+  };
+} // namespace
+
+TEST(HalfDiscs, TwoBodiesSqueezingGrainsEachTakeTheirOwnContactsImpulses)
+{
+  // Each chain's momentum changes over a step by its load's impulse minus the impulses of
+  // the contacts on its own half-discs (the nodes' shares -J_A^T f, -J_B^T f sum to -f):
+  // the engine routes every half-disc contact to its own body. The loads cancel, so the
+  // total momentum is conserved; KE + both chains' energies change by h (P_ext + P_c).
+  SolverParameters prm;
+  prm.method         = SolverParameters::Method::nlgs;
+  prm.tolerance      = 1e-10;
+  prm.check_interval = 1;
+  TwoBodies  t(prm);
+  const double h = 1e-9;
+  ASSERT_EQ(t.mj.n_boundary_bodies(), 2u);
+  const Vec2 p0 = t.grain_momentum() + t.lower.momentum() + t.upper.momentum();
+  double     e0 = t.s.kinetic_energy() + t.lower.energy() + t.upper.energy();
+  unsigned   both = 0;
+  for (int i = 0; i < 300; ++i)
+    {
+      const Vec2 lower0 = t.lower.momentum(), upper0 = t.upper.momentum();
+      const auto rep    = t.mj.step(t.s, h);
+      Vec2       on[2]  = {Vec2::Zero(), Vec2::Zero()};
+      unsigned   count[2] = {0, 0};
+      for (const Contact &c : t.mj.contacts())
+        if (c.on_boundary())
+          {
+            ASSERT_LT(c.boundary_body, 2u);
+            on[c.boundary_body] += c.r.x() * c.normal + c.r.y() * Vec2(-c.normal.y(), c.normal.x());
+            ++count[c.boundary_body];
+            // The first body's half-discs are numbered first: 8 per chain.
+            EXPECT_EQ(c.half_disc / 8, int(c.boundary_body));
+            EXPECT_EQ(c.node[0] / 8, c.boundary_body);
+          }
+      EXPECT_EQ(count[0] + count[1], rep.n_boundary_contacts);
+      both += count[0] > 0 && count[1] > 0 && on[0].norm() > 0 && on[1].norm() > 0;
+      const double scale = h * 8 * 100.0 + on[0].norm() + on[1].norm();
+      const Vec2   d_lower = t.lower.momentum() - lower0 - (h * 8 * t.lower.load - on[0]);
+      const Vec2   d_upper = t.upper.momentum() - upper0 - (h * 8 * t.upper.load - on[1]);
+      EXPECT_LT(d_lower.norm(), 1e-9 * scale) << "step " << i;
+      EXPECT_LT(d_upper.norm(), 1e-9 * scale) << "step " << i;
+      const Vec2 p1 = t.grain_momentum() + t.lower.momentum() + t.upper.momentum();
+      EXPECT_LT((p1 - p0).norm(), 1e-9 * (t.lower.momentum().norm() + t.grain_momentum().norm() + scale))
+        << "step " << i;
+      const double e1  = rep.kinetic_energy + rep.boundary_energy;
+      const double rhs = h * (rep.power_external + rep.power_contacts - rep.boundary_dissipation);
+      // Round-off: the 24 grains' and 16 nodes' energies summed (up to 4e-14 of the total).
+      EXPECT_NEAR(e1 - e0, rhs, 1e-9 * (std::abs(e1 - e0) + std::abs(rhs)) + 2e-13 * e1) << "step " << i;
+      e0 = e1;
+    }
+  EXPECT_GT(both, 150u); // the layer is squeezed by both bodies for most of the steps
+  EXPECT_LT(t.lower.x[0].y() + 0.5 * l, t.upper.x[0].y() - 0.5 * l); // and holds them apart
+}
+
+TEST(HalfDiscs, TheAssembledOperatorCouplesHalfDiscsOnlyThroughTheirOwnBody)
+{
+  // The global methods' sparse Delassus operator (dem/linalg/delassus.h) with two bodies'
+  // half-disc contacts: every column equals the local velocities that a unit impulse on
+  // that contact gives through BodyState (the sweeps' route: each body's own compliance
+  // block), and two half-discs of different bodies that share no grain are not coupled.
+  SolverParameters prm;
+  prm.method    = SolverParameters::Method::nlgs;
+  prm.tolerance = 1e-8;
+  TwoBodies t(prm);
+  for (int i = 0; i < 40; ++i)
+    t.mj.step(t.s, 1e-9);
+  const std::vector<Contact> &contacts = t.mj.contacts();
+  BodyState                   state    = BodyState::of(t.s);
+  state.node_velocity                  = Eigen::VectorXd::Zero(2 * 16);
+  state.node_blocks                    = {{0, &t.lower.G}, {8, &t.upper.G}};
+  const Eigen::MatrixXd W = Eigen::MatrixXd(assemble_delassus(contacts, state, DelassusPart::full));
+  const std::size_t     n = contacts.size();
+  ASSERT_EQ(W.rows(), Eigen::Index(2 * n));
+  unsigned int on[2] = {0, 0}, uncoupled_pairs = 0;
+  for (std::size_t j = 0; j < n; ++j)
+    {
+      if (contacts[j].on_boundary())
+        ++on[contacts[j].boundary_body];
+      for (int k = 0; k < 2; ++k)
+        {
+          BodyState response = state;
+          for (auto &v : response.velocity)
+            v.setZero();
+          response.apply_impulse(contacts[j], Eigen::Vector2d::Unit(k));
+          for (std::size_t i = 0; i < n; ++i)
+            {
+              const Eigen::Vector2d u = response.local_velocity(contacts[i]);
+              EXPECT_NEAR(W(2 * i, 2 * j + k), u.x(), 1e-9 * W.cwiseAbs().maxCoeff()) << i << " " << j;
+              EXPECT_NEAR(W(2 * i + 1, 2 * j + k), u.y(), 1e-9 * W.cwiseAbs().maxCoeff()) << i << " " << j;
+            }
+        }
+      for (std::size_t i = 0; i < n; ++i)
+        if (contacts[i].on_boundary() && contacts[j].on_boundary() &&
+            contacts[i].boundary_body != contacts[j].boundary_body && contacts[i].body[1] != contacts[j].body[1])
+          {
+            EXPECT_EQ((W.block<2, 2>(2 * i, 2 * j).norm()), 0.0);
+            ++uncoupled_pairs;
+          }
+    }
+  EXPECT_GE(on[0], 4u);
+  EXPECT_GE(on[1], 4u);
+  EXPECT_GT(uncoupled_pairs, 0u);
 }
