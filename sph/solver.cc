@@ -261,8 +261,13 @@ namespace tribo::sph
     else
       parallel_for(n, [&](unsigned int i) { particle(i, std::false_type()); });
 
-    if constexpr (!forces)
-      return;
+    if constexpr (forces)
+      add_loads(s, t, k);
+  }
+
+  template <int dim>
+  void Solver<dim>::add_loads(const ParticleState<dim> &s, double t, Rates<dim> &k) const
+  {
     for (const auto &ef : external)
       {
         const double ramp = ef.tau > 0 ? 1 - std::exp(-t / ef.tau) : 1.0;

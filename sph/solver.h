@@ -260,6 +260,10 @@ namespace tribo::sph
     };
     template <Pass pass>
     void   evaluate(const ParticleState<dim> &s, double t, Rates<dim> &k, bool viscosity = true);
+    /// The external forces (ramped by 1 - exp(-t / tau)) added to the accelerations k.dv at
+    /// time @p t (s), then the imposed-velocity components' accelerations removed, their
+    /// reactions -m dv (N) summed into k.imposed_force, one per ImposedVelocity entry.
+    void   add_loads(const ParticleState<dim> &s, double t, Rates<dim> &k) const;
     double midpoint_step(double dt_limit);
     double leapfrog_step(double dt_limit);
     /// The step from rates @p k at the state's start (step()); RunError below dt_min.
