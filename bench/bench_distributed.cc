@@ -1,5 +1,6 @@
 // The contact solve of one step across MPI ranks (dem/parallel/): how many more sweeps the
-// coupling across ranks takes than the serial Gauss-Seidel, and the time per sweep.
+// coupling across ranks takes than the same sweeps on one rank, and the time per sweep, for
+// the Gauss-Seidel sweeps in velocity form and APGS's in operator form, with and without momentum.
 // Every rank runs the same serial trajectory of CASE for STEPS steps (no distributed
 // engine yet), then takes the last step's own problem (its free velocities: the end
 // velocities less the impulses' effect), warm-started as the engine does (each contact from
@@ -9,6 +10,7 @@
 // scripts/scaling_model.py takes).
 // Usage: mpirun -np N bench_distributed [CASE.prm] [STEPS] [--set "Section/Entry=value"]...
 #include "bench/bench_case.h"
+#include "dem/parallel/distributed_apgs.h"
 #include "dem/parallel/distributed_gauss_seidel.h"
 #include "dem/solvers/contact_solver.h"
 
@@ -101,9 +103,9 @@ int main(int argc, char **argv)
       {
         const auto &problem = warm_start ? warm_contacts : contacts;
         const auto &state   = warm_start ? warm : free;
-        // The distributed solve on @p comm's ranks, with or without momentum: its report, the
-        // slowest rank's time and the ghosts on all ranks.
-        auto solve_on = [&](MPI_Comm comm, bool momentum) {
+        // The distributed solve on @p comm's ranks, in APGS's operator form or not, with or
+        // without momentum: its report, the slowest rank's time and the ghosts on all ranks.
+        auto solve_on = [&](MPI_Comm comm, bool operator_form, bool momentum) {
           const unsigned int         ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
           dem::parallel::RankProblem share =
             dem::parallel::share_of(system, problem, state, dem::parallel::contact_bands(system, problem, ranks),
@@ -112,10 +114,12 @@ int main(int argc, char **argv)
           controls.residual_target = target;
           controls.max_sweeps      = 200000;
           controls.momentum        = momentum;
-          dem::parallel::DistributedGaussSeidel solver(share, comm);
+          dem::parallel::DistributedGaussSeidel gauss_seidel(share, comm);
+          dem::parallel::DistributedApgs        apgs_form(share, comm);
           MPI_Barrier(comm);
           const auto   t0     = Clock::now();
-          const auto   report = solver.solve(share, mj.law(), controls, p.theta * h);
+          const auto   report = operator_form ? apgs_form.solve(share, mj.law(), controls, p.theta * h)
+                                              : gauss_seidel.solve(share, mj.law(), controls, p.theta * h);
           const double t      = std::chrono::duration<double>(Clock::now() - t0).count();
           return std::make_tuple(report, dealii::Utilities::MPI::max(t, comm),
                                  dealii::Utilities::MPI::sum(double(share.n_ghost), comm));
@@ -135,20 +139,22 @@ int main(int argc, char **argv)
         const auto                t0            = Clock::now();
         const auto apgs_report = dem::make_contact_solver(apgs)->solve(apgs_contacts, apgs_state, mj.law(), p.theta * h);
         const double apgs_time = std::chrono::duration<double>(Clock::now() - t0).count();
+        for (const bool operator_form : {false, true})
         for (const bool momentum : {false, true})
           {
-            const auto [serial, serial_time, unused] = solve_on(MPI_COMM_SELF, momentum);
-            const auto [here, here_time, ghosts]     = solve_on(world, momentum);
+            const auto [serial, serial_time, unused] = solve_on(MPI_COMM_SELF, operator_form, momentum);
+            const auto [here, here_time, ghosts]     = solve_on(world, operator_form, momentum);
             (void)unused;
             const auto [bytes, exchanges, reductions, neighbours] = traffic(here);
             if (rank == 0 && n > 1)
               std::printf("  rank 0 per sweep: %.0f bytes sent, %.2f exchanges with %u neighbours, %.2f sums over the ranks\n",
                           bytes, exchanges, neighbours, reductions);
             if (rank == 0)
-              std::printf("%s, target %g, %s: %u ranks %u sweeps (law residual %.2e) in %.4f s, one rank %u sweeps "
+              std::printf("%s, target %g, %s %s: %u ranks %u sweeps (law residual %.2e) in %.4f s, one rank %u sweeps "
                           "in %.4f s (sweeps x %.3f, T1 / (N TN) %.2f), %.0f ghosts; APGS one core %u iterations "
                           "in %.4f s (law residual %.2e)\n",
-                          warm_start ? "warm" : "cold", target, momentum ? "momentum" : "plain", n, here.sweeps,
+                          warm_start ? "warm" : "cold", target, operator_form ? "APGS sweeps" : "Gauss-Seidel",
+                          momentum ? "momentum" : "plain", n, here.sweeps,
                           here.law_residual, here_time, serial.sweeps, serial_time,
                           double(here.sweeps) / serial.sweeps, serial_time / (n * here_time), ghosts,
                           apgs_report.iterations, apgs_time, apgs_report.law_residual);

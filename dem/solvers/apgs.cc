@@ -99,56 +99,14 @@ namespace tribo::dem
       choose_slabs();
     }
 
-    /// Contact j's natural map in N s/m, y's rows set in op and @p g_n its normal row of
-    /// A'y + b': without friction |min(y_j, g_j)| / sqrt(D_j); with friction the norm of
-    /// (phi_n, phi_t) of dem/laws/law_residual.h in the scaled variables (unit normal diagonal,
-    /// tangent diagonal A'_tt), times the contact's scale.
     double ApgsRun::contact_map(const Eigen::VectorXd &y, Eigen::Index j, double g_n) const
     {
-      if (w == 1)
-        return std::abs(std::min(y[j], g_n)) * scaled.inv_root[j];
-      const Eigen::Index k     = 2 * j;
-      const double       g_t   = op.row_times(y, k + 1) + scaled.b[k + 1];
-      const double       r_law = std::max(0.0, y[k] - g_n);
-      const double       bound = problem.friction * r_law;
-      const double       phi_n = y[k] - r_law;
-      const double       phi_t = y[k + 1] - std::clamp(y[k + 1] - g_t / problem.own_block[j](1, 1), -bound, bound);
-      return std::sqrt(phi_n * phi_n + phi_t * phi_t) * scaled.inv_root[k];
+      return problem.contact_map(op, scaled.b, y, j, g_n);
     }
 
-    /// Contact j's local solve in v (rows set in op), the low-rank product kept current and,
-    /// with @p also, the same changes added to it: without friction v_j = max(0, v_j - g_j)
-    /// (unit diagonal); with friction the exact 2x2 Coulomb solve against the contact's own
-    /// block B, u = B v_j + q (ContactLaw::solve_coulomb; v_j = 0 if q_n >= 0).
     void ApgsRun::relax(Eigen::VectorXd &v, Eigen::Index j, Eigen::VectorXd *also)
     {
-      const Eigen::VectorXd &b = scaled.b;
-      if (w == 1)
-        {
-          const double next = std::max(0.0, v[j] - (op.row_times(v, j) + b[j]));
-          if (next != v[j])
-            {
-              op.add_to_low_rank(j, next - v[j]);
-              if (also)
-                (*also)[j] += next - v[j];
-              v[j] = next;
-            }
-          return;
-        }
-      const Eigen::Index     k   = 2 * j;
-      const Eigen::Matrix2d &B   = problem.own_block[j];
-      const double           q_n = op.row_times(v, k) + b[k] - B(0, 0) * v[k] - B(0, 1) * v[k + 1];
-      const double           q_t = op.row_times(v, k + 1) + b[k + 1] - B(1, 0) * v[k] - B(1, 1) * v[k + 1];
-      const Eigen::Vector2d  next = q_n < 0 ? law.solve_coulomb(B(0, 0), B(0, 1), B(1, 0), B(1, 1), q_n, q_t)
-                                            : Eigen::Vector2d::Zero();
-      for (int p = 0; p < 2; ++p)
-        if (next[p] != v[k + p])
-          {
-            op.add_to_low_rank(k + p, next[p] - v[k + p]);
-            if (also)
-              (*also)[k + p] += next[p] - v[k + p];
-            v[k + p] = next[p];
-          }
+      problem.relax(op, law, scaled.b, v, j, also);
     }
 
     /// Whether a row of contact j has low-rank entries (a wall's contact).

@@ -80,11 +80,9 @@ namespace tribo::dem
   {
     for (Eigen::Index i = 0; i < n_contacts(); ++i)
       {
-        Contact              &c = contacts[i];
-        const Eigen::Index    k = width * i;
-        const Eigen::Vector2d r_new(std::max(0.0, y[k] * scaled.inv_root[k]) - cohesion[i],
-                                    width == 2 ? y[k + 1] * scaled.inv_root[k + 1] : 0.0);
-        const Eigen::Vector2d dr = r_new - c.r;
+        Contact              &c     = contacts[i];
+        const Eigen::Vector2d r_new = impulse(y, i);
+        const Eigen::Vector2d dr    = r_new - c.r;
         if (dr.x() != 0 || dr.y() != 0)
           state.apply_impulse(c, dr);
         c.r = r_new;

@@ -1,6 +1,7 @@
 // The contact solve across MPI ranks (dem/parallel/): run by ctest on 1, 2, 3 and 4 ranks
 // (tests/unit/CMakeLists.txt). Every assertion follows the collective calls, so that a
 // failure on one rank cannot leave the others waiting.
+#include "dem/parallel/distributed_apgs.h"
 #include "dem/parallel/distributed_gauss_seidel.h"
 #include "tests/unit/tall_layer.h"
 
@@ -207,6 +208,13 @@ namespace
   /// The loaded upper wall, which lands on the layer: the last body of tall_layer().
   unsigned int upper_wall(const ColdStart &cold) { return static_cast<unsigned int>(cold.system.bodies.size()) - 1; }
 
+  /// The two distributed solves: Gauss-Seidel in velocity form, APGS's sweeps in operator form.
+  enum class Sweeps
+  {
+    gauss_seidel,
+    apgs
+  };
+
   /// Solve @p cold's problem on @p comm's ranks (MPI_COMM_SELF: the serial solve) to
   /// @p target; the report, and the gathered velocities and upper wall's impulse.
   struct Distributed
@@ -214,7 +222,8 @@ namespace
     DistributedReport            report;
     std::vector<Eigen::Vector3d> velocity;
     Eigen::Vector2d              wall_impulse;
-    Distributed(const ColdStart &cold, double target, MPI_Comm comm, bool momentum = true)
+    Distributed(const ColdStart &cold, double target, MPI_Comm comm, bool momentum = true,
+                Sweeps sweeps = Sweeps::gauss_seidel)
     {
       const unsigned int n = dealii::Utilities::MPI::n_mpi_processes(comm);
       RankProblem        p = share_of(cold.system, cold.contacts, BodyState::of(cold.system),
@@ -224,7 +233,8 @@ namespace
       controls.residual_target = target;
       controls.max_sweeps      = 100000;
       controls.momentum        = momentum;
-      report       = DistributedGaussSeidel(p, comm).solve(p, cold.law, controls);
+      report       = sweeps == Sweeps::apgs ? DistributedApgs(p, comm).solve(p, cold.law, controls)
+                                                : DistributedGaussSeidel(p, comm).solve(p, cold.law, controls);
       wall_impulse = impulse_on(p.contacts, p.serial_body, upper_wall(cold), true);
       if (comm == world())
         velocity = gathered_velocities(p, cold.system.bodies.size());
@@ -233,12 +243,13 @@ namespace
 
   /// The distributed solve against the serial interior point (frictionless) or NLGS
   /// (friction) converged far below @p target: velocities and the upper wall's impulse.
-  void expect_serial_answer(const ColdStart &cold, double target, double velocity_bound, double impulse_bound)
+  void expect_serial_answer(const ColdStart &cold, double target, double velocity_bound, double impulse_bound,
+                            Sweeps sweeps = Sweeps::gauss_seidel)
   {
     SerialReference reference(cold, 1e-12);
-    const Distributed     here(cold, target, world());
-    const Distributed     one_rank(cold, target, MPI_COMM_SELF);
-    const Distributed     plain(cold, target, MPI_COMM_SELF, false);
+    const Distributed     here(cold, target, world(), true, sweeps);
+    const Distributed     one_rank(cold, target, MPI_COMM_SELF, true, sweeps);
+    const Distributed     plain(cold, target, MPI_COMM_SELF, false, sweeps);
     EXPECT_TRUE(here.report.converged);
     EXPECT_LE(here.report.law_residual, target);
     double worst = 0;
@@ -248,7 +259,7 @@ namespace
     const Eigen::Vector2d serial_impulse = impulse_on(reference.contacts, identity(cold.system.bodies.size()), upper_wall(cold), false);
     EXPECT_LT((here.wall_impulse - serial_impulse).norm(), impulse_bound * serial_impulse.norm());
     // The coupling across ranks costs sweeps; how many is what docs/scaling.md reports.
-    std::cout << "[ measure  ] " << n_ranks() << " ranks: " << here.report.sweeps << " sweeps (one rank "
+    std::cout << "[ measure  ] " << (sweeps == Sweeps::apgs ? "APGS sweeps, " : "Gauss-Seidel, ") << n_ranks() << " ranks: " << here.report.sweeps << " sweeps (one rank "
               << one_rank.report.sweeps << ", without momentum " << plain.report.sweeps << "), law residual " << here.report.law_residual
               << ", worst velocity difference " << worst << " m/s, upper wall impulse " << here.wall_impulse.transpose()
               << " against serial " << serial_impulse.transpose() << " N s/m" << std::endl;
@@ -262,6 +273,10 @@ namespace
     if (cold.law.friction > 0) // plain sweeps: no restart sums
       {
         EXPECT_EQ(r.reductions, r.exchanges + 2 * r.checks);
+      }
+    if (sweeps == Sweeps::apgs) // one exchange per sweep, one more on a check with momentum,
+      {                          // one at the end; the final check in velocity form
+        EXPECT_EQ(r.exchanges, cold.law.friction > 0 ? r.sweeps + 1 : r.sweeps + r.checks - 1);
       }
     if (cold.law.friction <= 0) // the momentum still pays across ranks
       {
@@ -282,6 +297,19 @@ TEST(Distributed, CoulombFrictionSolveGivesTheSerialAnswer)
   ContactLaw law;
   law.friction = 0.3;
   expect_serial_answer(ColdStart(law), 1e-9, 1e-6, 1e-6);
+}
+
+TEST(Distributed, ApgsSweepsGiveTheSerialVelocitiesAndWallForce)
+{
+  // APGS's operator-form sweeps, the other ranks' impulses in each rank's b': the same answer.
+  expect_serial_answer(ColdStart(), 1e-9, 1e-6, 1e-6, Sweeps::apgs);
+}
+
+TEST(Distributed, ApgsSweepsWithCoulombFrictionGiveTheSerialAnswer)
+{
+  ContactLaw law;
+  law.friction = 0.3;
+  expect_serial_answer(ColdStart(law), 1e-9, 1e-6, 1e-6, Sweeps::apgs);
 }
 
 int main(int argc, char **argv)

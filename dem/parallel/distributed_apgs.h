@@ -1,0 +1,51 @@
+#pragma once
+/// @file APGS's sweeps (dem/solvers/apgs.h) across MPI ranks (dem/parallel/README.md): each
+/// rank sweeps its own contacts in APGS's operator form, coupled across ranks after every
+/// sweep through the grains' velocities.
+///
+/// Each rank assembles the scaled problem of its own contacts (dem/solvers/sweep_problem.h:
+/// y, A' + U'U'^T over the bodies they share, ghosts and walls included, b') with
+///     u_free,j = u_j(state) - (W_local r_warm)_j,
+/// the local velocity of contact j without this rank's warm-start impulses: what every
+/// other rank's contacts put on its ghost grains and on the walls is in b'. A sweep is
+/// APGS's projected Gauss-Seidel sweep over the rank's contacts (SweepProblem::relax, the
+/// walls' low-rank part kept current in place). After it, the contacts that touch a shared
+/// body (a ghost, an exported grain, a wall with a free degree of freedom) put their impulse
+/// changes since the last exchange on the state's velocities, the grains' velocities are
+/// exchanged (GrainExchange: ghost-to-owner sums, owner-to-ghost values, the walls' changes
+/// summed), and what the other ranks changed on a shared body, dv, moves b' of the contacts
+/// on it by s_j H_j^T dv. Inside a rank this is APGS's sweep; across ranks a Jacobi step, as
+/// in DistributedGaussSeidel: those interface contacts are relaxed by
+/// DistributedControls::interface_relaxation when the momentum is on.
+///
+/// Without friction the sweeps carry APGS's Nesterov momentum with its gradient restart (one
+/// sum over the ranks per sweep), the next sweep's start exchanged after the extrapolation;
+/// with friction plain sweeps (the law is not associated). Every check_interval sweeps the
+/// iterate is exchanged and its map, max_j |phi_j| (N s/m, SweepProblem::contact_map) over
+/// the mean loaded impulse, is reduced over the ranks: the stopping test, as APGS's. APGS's
+/// local polish and frictional safeguard are not carried over. At the end every contact's
+/// impulse is written, the velocities are exchanged once more, and the report's law residual
+/// is the velocity form's over all ranks (global_law_residual).
+
+#include "dem/parallel/grain_exchange.h"
+
+namespace tribo::dem::parallel
+{
+  class DistributedApgs
+  {
+  public:
+    /// The exchange pattern of @p problem's owned and ghost grains (collective on @p comm).
+    DistributedApgs(const RankProblem &problem, MPI_Comm comm);
+    /// Solve @p problem's contacts (warm-started from their impulses, whose effect must be
+    /// in its state) under @p law; @p theta_h turns velocity violations into gap violations.
+    /// Collective; every rank returns the same report, and its owned and ghost velocities
+    /// agree with their owners' after the last exchange. The report's sweeps count APGS's
+    /// sweeps; its checks include the final one.
+    DistributedReport solve(RankProblem &problem, const ContactLaw &law, const DistributedControls &controls,
+                            double theta_h = 0);
+
+  private:
+    GrainExchange exchange;
+    MPI_Comm      comm;
+  };
+} // namespace tribo::dem::parallel

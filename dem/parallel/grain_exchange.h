@@ -1,0 +1,91 @@
+#pragma once
+/// @file What the distributed contact solves share (dem/parallel/README.md): their controls and
+/// report, the exchange of the grains' velocities between ranks after a sweep, and the law
+/// residual over all ranks.
+
+#include "dem/laws/contact_law.h"
+#include "dem/parallel/rank_problem.h"
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace tribo::dem::parallel
+{
+  struct DistributedControls
+  {
+    double       residual_target = 1e-4;  ///< stop below this global relative law residual
+    unsigned int max_sweeps      = 10000; ///< then stop, not converged
+    unsigned int check_interval  = 10;    ///< sweeps between law-residual checks
+    /// Nesterov's momentum on the sweeps with the gradient restart, as APGS (dem/solvers/apgs.h)
+    /// puts it on its own: on the frictionless law only (with friction the law is not
+    /// associated and plain sweeps are used). Off: the plain sweep.
+    bool momentum = true;
+    /// With momentum, the relaxation omega (r <- omega r_law + (1 - omega) r) of the contacts
+    /// that touch a grain other ranks' contacts touch too. Their sweeps are Jacobi steps across
+    /// the ranks, and with omega = 1 the momentum amplifies their overshoot until the solve
+    /// diverges (the established code's sample on two ranks); 0.5 halves what two ranks
+    /// put on one grain at once, and the sweeps are then the one-rank count (docs/scaling.md).
+    double interface_relaxation = 0.5;
+  };
+
+  /// What a distributed solve achieved; the same on every rank.
+  struct DistributedReport
+  {
+    unsigned int sweeps        = 0;
+    unsigned int checks        = 0;
+    double       law_residual  = 0; ///< over every rank's contacts at the last check
+    double       gap_violation = 0; ///< theta h max(0, -(u_n + b)) over every IQS contact, m
+    bool         converged     = false;
+    /// This rank's traffic over the solve: exchanges (each two messages to every neighbour,
+    /// ghost-to-owner and owner-to-ghost), the bytes it sent in them, and the sums over all
+    /// ranks it took part in (the walls', the momentum's restart, the stopping test's).
+    unsigned int  exchanges  = 0;
+    std::uint64_t bytes_sent = 0;
+    unsigned int  reductions = 0;
+    unsigned int  neighbours = 0; ///< ranks it exchanges with
+  };
+
+  /// The exchange of a RankProblem's shared bodies' velocities after local changes:
+  /// - the velocity changes this rank made to ghost grains go to their owners, which add them
+  ///   (ghost-to-owner sums: deal.II's LinearAlgebra::distributed::Vector::compress(add));
+  /// - the owners' velocities go to the ghosts (owner-to-ghost: update_ghost_values());
+  /// - the changes every rank made to the replicated bodies (the walls) are summed over the
+  ///   ranks (one reduction of 3 values per replicated body).
+  /// Only the exported grains' entries (owned grains that are ghosts elsewhere) are touched.
+  class GrainExchange
+  {
+  public:
+    /// The exchange pattern of @p problem's owned and ghost grains (collective on @p comm).
+    GrainExchange(const RankProblem &problem, MPI_Comm comm);
+    ~GrainExchange();
+
+    /// Local numbers of the exported grains: owned here, ghosts on another rank.
+    const std::vector<unsigned int> &exported() const;
+    /// Ranks this one exchanges with.
+    unsigned int neighbours() const;
+    /// Remember @p state's velocities of the ghost and replicated bodies: local changes are
+    /// counted from here.
+    void remember(const BodyState &state);
+    /// Collective: after local changes to @p state since remember(), exchange them (above);
+    /// @p state's shared bodies then hold every rank's changes. Counts the traffic in @p report.
+    void exchange(BodyState &state, DistributedReport &report);
+
+  private:
+    struct Vector;
+    std::unique_ptr<Vector>      vector;
+    MPI_Comm                     comm;
+    unsigned int                 n_owned, n_ghost, n_local;
+    std::vector<Eigen::Vector3d> before;
+    std::vector<double>          wall_change, wall_sum;
+    unsigned int                 peers = 0;
+  };
+
+  /// Collective: the law residual (dem/laws/law_residual.h) over every rank's contacts of
+  /// @p problem, max |phi| over the mean loaded impulse, and the gap violation, into
+  /// @p report (two reductions); true when below @p target.
+  bool global_law_residual(const RankProblem &problem, const ContactLaw &law, double theta_h, double target,
+                           MPI_Comm comm, DistributedReport &report);
+} // namespace tribo::dem::parallel
