@@ -14,114 +14,193 @@ namespace tribo::dem::parallel
     , comm(comm)
   {}
 
-  DistributedReport DistributedApgs::solve(RankProblem &p, const ContactLaw &law, const DistributedControls &controls,
-                                           double theta_h)
+  namespace
   {
-    DistributedReport     report;
-    report.neighbours     = exchange.neighbours();
-    std::vector<Contact> &contacts = p.contacts;
-    const Eigen::Index    n = static_cast<Eigen::Index>(contacts.size());
-    const unsigned int    n_local = static_cast<unsigned int>(p.serial_body.size()), first_rep = p.n_owned + p.n_ghost;
+    /// One rank's part of a distributed APGS solve (the method is in dem/parallel/distributed_apgs.h):
+    /// its scaled problem with the moving b', the interface contacts and the exchange of their
+    /// impulses, the sweep and the map over all ranks.
+    class RankSweeps
+    {
+    public:
+      RankSweeps(RankProblem &p, const ContactLaw &law, GrainExchange &exchange, MPI_Comm comm,
+                 DistributedReport &report);
+      /// APGS's projected Gauss-Seidel sweep of @p v in place, the contacts on grains of two
+      /// ranks relaxed by @p omega.
+      void sweep(Eigen::VectorXd &v, double omega);
+      /// Exchange the interface contacts' impulses at @p v: their changes since the last
+      /// exchange go on the state, the velocities are exchanged, and what the other ranks
+      /// changed on a shared body dv moves b' of the contacts on it by s_j H_j^T dv.
+      void sync(const Eigen::VectorXd &v);
+      /// The map over every rank's contacts at @p v (exchanged), relative to the mean loaded
+      /// impulse (or, with none loaded, the largest of the ranks' scales).
+      double relative_map(const Eigen::VectorXd &v);
+      /// Every contact's impulse at @p y: the interface contacts' through one more exchange,
+      /// the others' on the grains only this rank holds; the caller's free velocities back.
+      void finish(const Eigen::VectorXd &y);
+      /// The scaled warm start, rows per contact.
+      const SweepProblem &problem() const { return sweep_problem; }
 
-    // Shared bodies: grains other ranks' contacts touch (ghosts here, exported grains), whose
-    // contacts are relaxed with momentum, and the walls with a free degree of freedom, whose
-    // changes are summed over the ranks too.
-    std::vector<char> shared(n_local, 0), across(n_local, 0);
-    for (unsigned int l = p.n_owned; l < first_rep; ++l)
-      shared[l] = across[l] = 1;
-    for (const unsigned int l : exchange.exported())
-      shared[l] = across[l] = 1;
-    for (unsigned int l = first_rep; l < n_local; ++l)
-      {
-        const auto &im = p.state.inverse_mass[l];
-        shared[l]      = im[0] > 0 || im[1] > 0 || im[2] > 0;
-      }
-    std::vector<Eigen::Index> interface;
-    std::vector<char>         relaxed(n, 0);
-    for (Eigen::Index j = 0; j < n; ++j)
-      {
-        const Contact &c = contacts[j];
-        if (shared[c.body[0]] || shared[c.body[1]])
-          interface.push_back(j);
-        relaxed[j] = across[c.body[0]] || across[c.body[1]];
-      }
+    private:
+      RankProblem                 &p;
+      const ContactLaw            &law;
+      GrainExchange               &exchange;
+      MPI_Comm                     comm;
+      DistributedReport           &report;
+      std::vector<char>            shared;       ///< local bodies whose velocity other ranks change
+      std::vector<Eigen::Index>    interface;    ///< contacts on a shared body, increasing
+      std::vector<char>            across;       ///< contacts on a grain of two ranks
+      std::vector<Eigen::Vector2d> caller_u_free; ///< the contacts' free velocities as given
+      SweepProblem                 sweep_problem;
+      ScaledOperator               op;
+      Eigen::VectorXd              b;            ///< b', moved by the other ranks' impulses
+      std::vector<Eigen::Vector2d> sent;         ///< each contact's impulse in the state, N s/m
+      BodyState                    others;       ///< the other ranks' velocity changes at the last exchange
+      std::vector<Eigen::Vector3d> mine;         ///< the shared bodies' velocities before it
 
-    // The local free velocities: the state without this rank's warm-start impulses.
-    std::vector<Eigen::Vector2d> caller_u_free(n);
+      /// The contacts' free velocities without this rank's warm-start impulses (the caller's
+      /// kept): u_free,j = u_j(state) - (W_local r_warm)_j.
+      std::vector<Contact> &with_local_free_velocities();
+    };
+
+    RankSweeps::RankSweeps(RankProblem &p, const ContactLaw &law, GrainExchange &exchange, MPI_Comm comm,
+                           DistributedReport &report)
+      : p(p)
+      , law(law)
+      , exchange(exchange)
+      , comm(comm)
+      , report(report)
+      , shared(p.serial_body.size(), 0)
+      , across(p.contacts.size(), 0)
+      , sweep_problem(with_local_free_velocities(), p.state, law)
+      , op(sweep_problem.scaled)
+      , b(sweep_problem.scaled.b)
+      , mine(p.serial_body.size())
+    {
+      // Shared bodies: grains other ranks' contacts touch (ghosts here, exported grains),
+      // whose contacts are relaxed with momentum, and the walls with a free degree of
+      // freedom, whose changes are summed over the ranks too.
+      const unsigned int n_local = static_cast<unsigned int>(p.serial_body.size()), first_rep = p.n_owned + p.n_ghost;
+      std::vector<char>  two_ranks(n_local, 0);
+      for (unsigned int l = p.n_owned; l < first_rep; ++l)
+        shared[l] = two_ranks[l] = 1;
+      for (const unsigned int l : exchange.exported())
+        shared[l] = two_ranks[l] = 1;
+      for (unsigned int l = first_rep; l < n_local; ++l)
+        {
+          const auto &im = p.state.inverse_mass[l];
+          shared[l]      = im[0] > 0 || im[1] > 0 || im[2] > 0;
+        }
+      for (std::size_t j = 0; j < p.contacts.size(); ++j)
+        {
+          const Contact &c = p.contacts[j];
+          if (shared[c.body[0]] || shared[c.body[1]])
+            interface.push_back(Eigen::Index(j));
+          across[j] = two_ranks[c.body[0]] || two_ranks[c.body[1]];
+          sent.push_back(c.r);
+        }
+      others.velocity.assign(n_local, Eigen::Vector3d::Zero());
+      others.inverse_mass = p.state.inverse_mass;
+    }
+
+    std::vector<Contact> &RankSweeps::with_local_free_velocities()
     {
       BodyState without = p.state;
-      for (const Contact &c : contacts)
+      for (const Contact &c : p.contacts)
         if (c.r.x() != 0 || c.r.y() != 0)
           without.apply_impulse(c, -c.r);
-      for (Eigen::Index j = 0; j < n; ++j)
+      for (Contact &c : p.contacts)
         {
-          caller_u_free[j]   = contacts[j].u_free;
-          contacts[j].u_free = without.local_velocity(contacts[j]);
+          caller_u_free.push_back(c.u_free);
+          c.u_free = without.local_velocity(c);
         }
+      return p.contacts;
     }
-    const SweepProblem     problem(contacts, p.state, law);
-    const Eigen::VectorXd &s = problem.scaled.inv_root;
-    const Eigen::Index     w = problem.width, rows = w * n;
-    ScaledOperator         op(problem.scaled);
-    Eigen::VectorXd        b = problem.scaled.b;
 
-    // Exchange the interface contacts' impulses at @p v: their changes since the last
-    // exchange go on the state, the velocities are exchanged, and what the other ranks
-    // changed on a shared body moves b' of the contacts on it.
-    std::vector<Eigen::Vector2d> sent(n);
-    for (Eigen::Index j = 0; j < n; ++j)
-      sent[j] = contacts[j].r;
-    BodyState others;
-    others.velocity.assign(n_local, Eigen::Vector3d::Zero());
-    others.inverse_mass = p.state.inverse_mass;
-    std::vector<Eigen::Vector3d> mine(n_local);
-    const auto                   sync = [&](const Eigen::VectorXd &v) {
+    void RankSweeps::sweep(Eigen::VectorXd &v, double omega)
+    {
+      op.set_vector(v);
+      for (Eigen::Index j = 0; j < Eigen::Index(p.contacts.size()); ++j)
+        sweep_problem.relax(op, law, b, v, j, nullptr, across[j] ? omega : 1.0);
+    }
+
+    void RankSweeps::sync(const Eigen::VectorXd &v)
+    {
       exchange.remember(p.state);
       for (const Eigen::Index j : interface)
         {
-          const Eigen::Vector2d r = problem.impulse(v, j), dr = r - sent[j];
+          const Eigen::Vector2d r = sweep_problem.impulse(v, j), dr = r - sent[j];
           if (dr.x() != 0 || dr.y() != 0)
-            p.state.apply_impulse(contacts[j], dr);
+            p.state.apply_impulse(p.contacts[j], dr);
           sent[j] = r;
         }
-      for (unsigned int l = 0; l < n_local; ++l)
+      for (std::size_t l = 0; l < shared.size(); ++l)
         if (shared[l])
           mine[l] = p.state.velocity[l];
       exchange.exchange(p.state, report);
-      for (unsigned int l = 0; l < n_local; ++l)
+      for (std::size_t l = 0; l < shared.size(); ++l)
         if (shared[l])
           others.velocity[l] = p.state.velocity[l] - mine[l];
+      const Eigen::Index     w = sweep_problem.width;
+      const Eigen::VectorXd &s = sweep_problem.scaled.inv_root;
       for (const Eigen::Index j : interface)
         {
-          const Eigen::Vector2d du = others.local_velocity(contacts[j]);
+          const Eigen::Vector2d du = others.local_velocity(p.contacts[j]);
           for (Eigen::Index k = 0; k < w; ++k)
             b[w * j + k] += s[w * j + k] * du[k];
         }
-    };
+    }
 
-    // The map over every rank's contacts at @p v (exchanged), relative to the mean loaded
-    // impulse (or, with none loaded, the largest of the ranks' scales).
-    const auto relative_map = [&](const Eigen::VectorXd &v) {
+    double RankSweeps::relative_map(const Eigen::VectorXd &v)
+    {
       ++report.checks;
       report.reductions += 2;
       op.set_vector(v);
-      double worst = 0, loaded[2] = {0, 0};
-      for (Eigen::Index j = 0; j < n; ++j)
+      const Eigen::Index     w = sweep_problem.width;
+      const Eigen::VectorXd &s = sweep_problem.scaled.inv_root;
+      double                 worst = 0, loaded[2] = {0, 0};
+      for (Eigen::Index j = 0; j < Eigen::Index(p.contacts.size()); ++j)
         {
           const Eigen::Index k = w * j;
-          worst                = std::max(worst, problem.contact_map(op, b, v, j, op.row_times(v, k) + b[k]));
+          worst = std::max(worst, sweep_problem.contact_map(op, b, v, j, op.row_times(v, k) + b[k]));
           if (v[k] > 0)
             {
               loaded[0] += v[k] * s[k];
               loaded[1] += 1;
             }
         }
-      const double maxima[2] = {worst, problem.scale};
+      const double maxima[2] = {worst, sweep_problem.scale};
       double       global_max[2], global_loaded[2];
       dealii::Utilities::MPI::max(maxima, comm, global_max);
       dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
       return global_max[0] / (global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : global_max[1]);
-    };
+    }
+
+    void RankSweeps::finish(const Eigen::VectorXd &y)
+    {
+      sync(y);
+      for (Eigen::Index j = 0; j < Eigen::Index(p.contacts.size()); ++j)
+        {
+          Contact &c = p.contacts[j];
+          if (!std::binary_search(interface.begin(), interface.end(), j))
+            {
+              const Eigen::Vector2d dr = sweep_problem.impulse(y, j) - c.r;
+              if (dr.x() != 0 || dr.y() != 0)
+                p.state.apply_impulse(c, dr);
+            }
+          c.r      = sweep_problem.impulse(y, j);
+          c.u_free = caller_u_free[j];
+        }
+    }
+  } // namespace
+
+  DistributedReport DistributedApgs::solve(RankProblem &p, const ContactLaw &law, const DistributedControls &controls,
+                                           double theta_h)
+  {
+    DistributedReport report;
+    report.neighbours = exchange.neighbours();
+    RankSweeps             rank(p, law, exchange, comm, report);
+    const SweepProblem    &problem = rank.problem();
+    const Eigen::Index     w = problem.width, rows = w * problem.n_contacts();
 
     // APGS's sweeps, with its momentum and gradient restart without friction.
     const bool      momentum = controls.momentum && w == 1;
@@ -132,15 +211,13 @@ namespace tribo::dem::parallel
     for (unsigned int sweep = 1; sweep <= controls.max_sweeps; ++sweep)
       {
         next = z;
-        op.set_vector(next);
-        for (Eigen::Index j = 0; j < n; ++j)
-          problem.relax(op, law, b, next, j, nullptr, relaxed[j] ? omega : 1.0);
+        rank.sweep(next, omega);
         report.sweeps    = sweep;
         const bool check = sweep % controls.check_interval == 0 || sweep == controls.max_sweeps;
         if (check)
           {
-            sync(next);
-            if (relative_map(next) <= controls.residual_target)
+            rank.sync(next);
+            if (rank.relative_map(next) <= controls.residual_target)
               {
                 y.swap(next);
                 report.converged = true;
@@ -168,24 +245,9 @@ namespace tribo::dem::parallel
             z = y;
           }
         if (!check || momentum)
-          sync(z);
+          rank.sync(z);
       }
-
-    // Every contact's impulse at y: the interface contacts' through one more exchange, the
-    // others' on the grains only this rank holds.
-    sync(y);
-    for (Eigen::Index j = 0; j < n; ++j)
-      {
-        Contact &c = contacts[j];
-        if (!std::binary_search(interface.begin(), interface.end(), j))
-          {
-            const Eigen::Vector2d dr = problem.impulse(y, j) - c.r;
-            if (dr.x() != 0 || dr.y() != 0)
-              p.state.apply_impulse(c, dr);
-          }
-        c.r      = problem.impulse(y, j);
-        c.u_free = caller_u_free[j];
-      }
+    rank.finish(y);
     const bool converged = report.converged;
     global_law_residual(p, law, theta_h, controls.residual_target, comm, report);
     report.converged = converged;
