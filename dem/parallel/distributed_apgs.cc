@@ -9,11 +9,6 @@
 
 namespace tribo::dem::parallel
 {
-  DistributedApgs::DistributedApgs(const RankProblem &p, MPI_Comm comm)
-    : exchange(p, comm)
-    , comm(comm)
-  {}
-
   namespace
   {
     /// One rank's part of a distributed APGS solve (the method is in dem/parallel/distributed_apgs.h):

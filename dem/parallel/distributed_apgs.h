@@ -27,25 +27,16 @@
 /// impulse is written, the velocities are exchanged once more, and the report's law residual
 /// is the velocity form's over all ranks (global_law_residual).
 
-#include "dem/parallel/grain_exchange.h"
+#include "dem/parallel/distributed_solve.h"
 
 namespace tribo::dem::parallel
 {
-  class DistributedApgs
+  class DistributedApgs : public DistributedSolver
   {
   public:
-    /// The exchange pattern of @p problem's owned and ghost grains (collective on @p comm).
-    DistributedApgs(const RankProblem &problem, MPI_Comm comm);
-    /// Solve @p problem's contacts (warm-started from their impulses, whose effect must be
-    /// in its state) under @p law; @p theta_h turns velocity violations into gap violations.
-    /// Collective; every rank returns the same report, and its owned and ghost velocities
-    /// agree with their owners' after the last exchange. The report's sweeps count APGS's
-    /// sweeps; its checks include the final one.
+    using DistributedSolver::DistributedSolver;
+    /// The report's sweeps count APGS's sweeps; its checks include the final one in velocity form.
     DistributedReport solve(RankProblem &problem, const ContactLaw &law, const DistributedControls &controls,
-                            double theta_h = 0);
-
-  private:
-    GrainExchange exchange;
-    MPI_Comm      comm;
+                            double theta_h = 0) override;
   };
 } // namespace tribo::dem::parallel

@@ -8,11 +8,6 @@
 
 namespace tribo::dem::parallel
 {
-  DistributedGaussSeidel::DistributedGaussSeidel(const RankProblem &p, MPI_Comm comm)
-    : exchange(p, comm)
-    , comm(comm)
-  {}
-
   DistributedReport DistributedGaussSeidel::solve(RankProblem &p, const ContactLaw &law,
                                                   const DistributedControls &controls, double theta_h)
   {

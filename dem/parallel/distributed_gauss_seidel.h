@@ -5,7 +5,7 @@
 /// Each rank sweeps its own contacts (the NLGS local solve, gauss_seidel_update in
 /// dem/solvers/nlgs.h: IQS or ELAS, cohesion, Coulomb friction) against its local bodies,
 /// ghosts included. After the sweep the grains' velocity changes are exchanged
-/// (GrainExchange, dem/parallel/grain_exchange.h).
+/// (GrainExchange, dem/parallel/distributed_solve.h).
 /// Inside a rank this is the serial Gauss-Seidel sweep; across ranks it is a Jacobi step:
 /// two contacts of different ranks on one grain both act on the velocity the last
 /// exchange left. On one rank, without momentum, it is the serial NLGS sweep in detection
@@ -21,24 +21,15 @@
 /// changes travel with the sweep's in the one exchange per sweep (two on check sweeps, where
 /// the residual is taken at y, before the extrapolation).
 
-#include "dem/parallel/grain_exchange.h"
+#include "dem/parallel/distributed_solve.h"
 
 namespace tribo::dem::parallel
 {
-  class DistributedGaussSeidel
+  class DistributedGaussSeidel : public DistributedSolver
   {
   public:
-    /// The exchange pattern of @p problem's owned and ghost grains (collective on @p comm).
-    DistributedGaussSeidel(const RankProblem &problem, MPI_Comm comm);
-    /// Solve @p problem's contacts (warm-started from their impulses, whose effect must be
-    /// in its state) under @p law; @p theta_h turns velocity violations into gap violations.
-    /// Collective; every rank returns the same report, and its owned and ghost velocities
-    /// agree with their owners' after the last exchange.
+    using DistributedSolver::DistributedSolver;
     DistributedReport solve(RankProblem &problem, const ContactLaw &law, const DistributedControls &controls,
-                            double theta_h = 0);
-
-  private:
-    GrainExchange exchange;
-    MPI_Comm      comm;
+                            double theta_h = 0) override;
   };
 } // namespace tribo::dem::parallel

@@ -83,6 +83,29 @@ namespace tribo::dem::parallel
     unsigned int                 peers = 0;
   };
 
+  /// A contact solve across ranks: a rank's sweeps over its own contacts, coupled to the
+  /// other ranks' through the GrainExchange of its problem.
+  class DistributedSolver
+  {
+  public:
+    /// The exchange pattern of @p problem's owned and ghost grains (collective on @p comm).
+    DistributedSolver(const RankProblem &problem, MPI_Comm comm)
+      : exchange(problem, comm)
+      , comm(comm)
+    {}
+    virtual ~DistributedSolver() = default;
+    /// Solve @p problem's contacts (warm-started from their impulses, whose effect must be
+    /// in its state) under @p law; @p theta_h turns velocity violations into gap violations.
+    /// Collective; every rank returns the same report, and its owned and ghost velocities
+    /// agree with their owners' after the last exchange.
+    virtual DistributedReport solve(RankProblem &problem, const ContactLaw &law, const DistributedControls &controls,
+                                    double theta_h) = 0;
+
+  protected:
+    GrainExchange exchange;
+    MPI_Comm      comm;
+  };
+
   /// Collective: the law residual (dem/laws/law_residual.h) over every rank's contacts of
   /// @p problem, max |phi| over the mean loaded impulse, and the gap violation, into
   /// @p report (two reductions); true when below @p target.

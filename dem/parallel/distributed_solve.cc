@@ -1,4 +1,4 @@
-#include "dem/parallel/grain_exchange.h"
+#include "dem/parallel/distributed_solve.h"
 
 #include "dem/laws/law_residual.h"
 
