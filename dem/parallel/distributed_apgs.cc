@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace tribo::dem::parallel
 {
@@ -197,12 +198,14 @@ namespace tribo::dem::parallel
     const SweepProblem    &problem = rank.problem();
     const Eigen::Index     w = problem.width, rows = w * problem.n_contacts();
 
-    // APGS's sweeps, with its momentum and gradient restart without friction.
-    const bool      momentum = controls.momentum && w == 1;
+    // APGS's sweeps with its momentum and gradient restart; with friction under its safeguard:
+    // the best iterate of the checks kept, the momentum dropped when a block raises the map.
+    const bool      momentum = controls.momentum;
     const double    omega    = momentum ? controls.interface_relaxation : 1.0;
     Eigen::VectorXd y = w == 1 ? Eigen::VectorXd(problem.scaled.y.cwiseMax(0.0)) : problem.scaled.y, y_last(rows),
-                    z = y, next(rows);
-    double t = 1;
+                    z = y, next(rows), best;
+    double t = 1, map = INFINITY, best_map = INFINITY, block_map = INFINITY;
+    bool   drop = false;
     for (unsigned int sweep = 1; sweep <= controls.max_sweeps; ++sweep)
       {
         next = z;
@@ -212,11 +215,23 @@ namespace tribo::dem::parallel
         if (check)
           {
             rank.sync(next);
-            if (rank.relative_map(next) <= controls.residual_target)
+            map = rank.relative_map(next);
+            if (map <= controls.residual_target)
               {
                 y.swap(next);
                 report.converged = true;
                 break;
+              }
+            if (w == 2 && momentum)
+              {
+                if (map < best_map)
+                  {
+                    best     = next;
+                    best_map = map;
+                  }
+                else
+                  drop = map > block_map;
+                block_map = map;
               }
           }
         if (momentum)
@@ -233,6 +248,11 @@ namespace tribo::dem::parallel
             y.swap(next);
             z = y + beta * (y - y_last);
             t = t_next;
+            if (std::exchange(drop, false))
+              {
+                t = 1;
+                z = y;
+              }
           }
         else
           {
@@ -242,6 +262,8 @@ namespace tribo::dem::parallel
         if (!check || momentum)
           rank.sync(z);
       }
+    if (!report.converged && best_map < map)
+      y = best; // the safeguard's best iterate
     rank.finish(y);
     const bool converged = report.converged;
     global_law_residual(p, law, theta_h, controls.residual_target, comm, report);

@@ -18,12 +18,14 @@
 /// in DistributedGaussSeidel: those interface contacts are relaxed by
 /// DistributedControls::interface_relaxation when the momentum is on.
 ///
-/// Without friction the sweeps carry APGS's Nesterov momentum with its gradient restart (one
-/// sum over the ranks per sweep), the next sweep's start exchanged after the extrapolation;
-/// with friction plain sweeps (the law is not associated). Every check_interval sweeps the
-/// iterate is exchanged and its map, max_j |phi_j| (N s/m, SweepProblem::contact_map) over
-/// the mean loaded impulse, is reduced over the ranks: the stopping test, as APGS's. APGS's
-/// local polish and frictional safeguard are not carried over. At the end every contact's
+/// The sweeps carry APGS's Nesterov momentum with its gradient restart (one sum over the ranks
+/// per sweep), the next sweep's start exchanged after the extrapolation. Every check_interval
+/// sweeps the iterate is exchanged and its map, max_j |phi_j| (N s/m, SweepProblem::contact_map)
+/// over the mean loaded impulse, is reduced over the ranks: the stopping test, as APGS's. With
+/// friction (the law is not associated) APGS's safeguard: the best iterate of the checks is
+/// kept and returned by a solve that ends above it, and a check that raises the map drops the
+/// momentum (t = 1, the next sweep from the iterate); every rank takes the same decision from
+/// the reduced map. APGS's local polish is not carried over. At the end every contact's
 /// impulse is written, the velocities are exchanged once more, and the report's law residual
 /// is the velocity form's over all ranks (global_law_residual).
 

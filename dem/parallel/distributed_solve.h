@@ -20,8 +20,9 @@ namespace tribo::dem::parallel
     unsigned int max_sweeps      = 10000; ///< then stop, not converged
     unsigned int check_interval  = 10;    ///< sweeps between law-residual checks
     /// Nesterov's momentum on the sweeps with the gradient restart, as APGS (dem/solvers/apgs.h)
-    /// puts it on its own: on the frictionless law only (with friction the law is not
-    /// associated and plain sweeps are used). Off: the plain sweep.
+    /// puts it on its own: without friction in both forms; with friction in DistributedApgs
+    /// only, under APGS's safeguard (the Gauss-Seidel form then sweeps plainly: the law is not
+    /// associated). Off: the plain sweep.
     bool momentum = true;
     /// With momentum, the relaxation omega (r <- omega r_law + (1 - omega) r) of the contacts
     /// that touch a grain other ranks' contacts touch too. Their sweeps are Jacobi steps across
