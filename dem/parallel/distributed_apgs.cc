@@ -43,6 +43,7 @@ namespace tribo::dem::parallel
       MPI_Comm                     comm;
       DistributedReport           &report;
       std::vector<char>            shared;       ///< local bodies whose velocity other ranks change
+      std::vector<unsigned int>    shared_list;  ///< their local numbers
       std::vector<Eigen::Index>    interface;    ///< contacts on a shared body, increasing
       std::vector<char>            across;       ///< contacts on a grain of two ranks
       std::vector<Eigen::Vector2d> caller_u_free; ///< the contacts' free velocities as given
@@ -86,6 +87,9 @@ namespace tribo::dem::parallel
           const auto &im = p.state.inverse_mass[l];
           shared[l]      = im[0] > 0 || im[1] > 0 || im[2] > 0;
         }
+      for (unsigned int l = 0; l < n_local; ++l)
+        if (shared[l])
+          shared_list.push_back(l);
       for (std::size_t j = 0; j < p.contacts.size(); ++j)
         {
           const Contact &c = p.contacts[j];
@@ -129,13 +133,11 @@ namespace tribo::dem::parallel
             p.state.apply_impulse(p.contacts[j], dr);
           sent[j] = r;
         }
-      for (std::size_t l = 0; l < shared.size(); ++l)
-        if (shared[l])
-          mine[l] = p.state.velocity[l];
+      for (const unsigned int l : shared_list)
+        mine[l] = p.state.velocity[l];
       exchange.exchange(p.state, report);
-      for (std::size_t l = 0; l < shared.size(); ++l)
-        if (shared[l])
-          others.velocity[l] = p.state.velocity[l] - mine[l];
+      for (const unsigned int l : shared_list)
+        others.velocity[l] = p.state.velocity[l] - mine[l];
       const Eigen::Index     w = sweep_problem.width;
       const Eigen::VectorXd &s = sweep_problem.scaled.inv_root;
       for (const Eigen::Index j : interface)
