@@ -2,10 +2,22 @@
 
 #include "core/errors.h"
 
+#include <deal.II/base/mpi.h>
+
 #include <cmath>
 
 namespace tribo::app
 {
+  unsigned int rank_count(MPI_Comm ranks)
+  {
+    return dealii::Utilities::MPI::job_supports_mpi() ? dealii::Utilities::MPI::n_mpi_processes(ranks) : 1;
+  }
+
+  unsigned int rank_in(MPI_Comm ranks)
+  {
+    return dealii::Utilities::MPI::job_supports_mpi() ? dealii::Utilities::MPI::this_mpi_process(ranks) : 0;
+  }
+
   using dealii::Patterns::Bool;
   using dealii::Patterns::Double;
   using dealii::Patterns::Integer;

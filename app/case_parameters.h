@@ -8,6 +8,8 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <mpi.h>
+
 #include <string>
 
 namespace tribo::app
@@ -27,7 +29,16 @@ namespace tribo::app
     bool         plots;               ///< PNG plots of a shear run (scripts/plot_run.py)
     double       checkpoint_interval;      ///< wall-clock seconds between checkpoints (0: none)
     unsigned int checkpoint_step_interval; ///< steps between checkpoints (0: none)
+    /// The MPI ranks the case runs on, not an entry: `tribo run` under mpirun runs one case on
+    /// all of them (its contact solve split into bands, dem/parallel/solve_across_ranks.h); a
+    /// case of `tribo study` runs on its own rank.
+    MPI_Comm ranks = MPI_COMM_SELF;
   };
+
+  /// The number of ranks of @p ranks, 1 when MPI is not initialised (`tribo run` without mpirun).
+  unsigned int rank_count(MPI_Comm ranks);
+  /// This process's rank in @p ranks, 0 when MPI is not initialised.
+  unsigned int rank_in(MPI_Comm ranks);
 
   /// Declare the entries every case has (Simulation, Contact law, Solver, Output): the
   /// part of declare_case_parameters() (app/scenes.h) that is not a scene's.

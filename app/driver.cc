@@ -1,8 +1,11 @@
 #include "app/driver.h"
 
+#include "app/case_parameters.h"
 #include "core/errors.h"
 #include "core/serialization.h"
 #include "core/run_control.h"
+
+#include <deal.II/base/mpi.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -131,6 +134,13 @@ namespace tribo::app
     namespace fs = std::filesystem;
     const fs::path dir = settings.dir;
     install_stop_handlers();
+    const bool writes = rank_in(settings.ranks) == 0;
+    // The signal any rank received (collective): every rank stops after the same step.
+    const auto stop_agreed = [&]() {
+      return rank_count(settings.ranks) > 1
+               ? dealii::Utilities::MPI::max(stop_requested(), settings.ranks)
+               : stop_requested();
+    };
     Statistics    stats;
     FieldWriter   fields((dir / "fields").string());
     unsigned long step = sim.first_step();
@@ -138,7 +148,8 @@ namespace tribo::app
     // After the header (RunCheckpoint): the step, the scene's state, the statistics and
     // the field index, in this order (core/checkpoint.h).
     const auto save_checkpoint = [&]() {
-      checkpoint.write([&](CheckpointOut &ar) {
+      if (writes)
+        checkpoint.write([&](CheckpointOut &ar) {
         ar << step;
         sim.save(ar);
         stats.table.save(ar);
@@ -159,7 +170,8 @@ namespace tribo::app
       {
         if (sim.row_at_start())
           stats.add(sim, step);
-        sim.write_snapshot(fields);
+        if (writes)
+          sim.write_snapshot(fields);
       }
 
     std::string  status = "complete", failure;
@@ -173,7 +185,7 @@ namespace tribo::app
       {
         while (!sim.reached_end(step))
           {
-            if (stop_requested())
+            if (stop_agreed())
               {
                 save_checkpoint();
                 status = "interrupted";
@@ -184,16 +196,16 @@ namespace tribo::app
             const bool last = sim.reached_end(step) || sim.finished();
             if (last || sim.row_due(step))
               stats.add(sim, step);
-            if (!last && sim.snapshot_due(step))
+            if (writes && !last && sim.snapshot_due(step))
               sim.write_snapshot(fields);
             const auto now = std::chrono::steady_clock::now();
-            if (std::chrono::duration<double>(now - last_flush).count() > 10)
+            if (writes && std::chrono::duration<double>(now - last_flush).count() > 10)
               {
                 atomic_write((dir / "statistics.csv").string(), stats.table.to_csv());
                 last_flush = now;
               }
             progress.update(sim.time(), step);
-            const bool stopping = stop_requested() != 0;
+            const bool stopping = stop_agreed() != 0;
             if (stopping || (!last && checkpoint.due(step)))
               save_checkpoint();
             if (stopping)
@@ -214,7 +226,7 @@ namespace tribo::app
     // The last step done gets its row, whatever the interval, and its snapshot.
     if (!stats.has_row_of(step))
       stats.add(sim, step);
-    if (status != "failed" || sim.snapshot_a_failed_state())
+    if (writes && (status != "failed" || sim.snapshot_a_failed_state()))
       sim.write_snapshot(fields);
 
     const double wall = checkpoint.wall_time();
@@ -236,6 +248,8 @@ namespace tribo::app
     out.scalars["simulated_time"] = sim.time();
     out.scalars["wall_time"]      = wall;
     out.scalars["complete"]       = status == "complete" ? 1.0 : 0.0;
+    if (!writes)
+      return finish_run(log, status, failure);
     atomic_write((dir / "statistics.csv").string(), stats.table.to_csv());
     for (const auto &[name, table] : out.tables)
       atomic_write((dir / (name + ".csv")).string(), table.to_csv());

@@ -9,6 +9,8 @@
 #include "core/checkpoint.h"
 #include "core/output.h"
 
+#include <mpi.h>
+
 #include <chrono>
 #include <functional>
 #include <map>
@@ -159,6 +161,10 @@ namespace tribo::app
     bool        quiet = false;
     /// Every resolved entry of the case, for results.h5 "parameters".
     std::map<std::string, std::string> parameters;
+    /// The ranks the case runs on (CaseParameters::ranks): each steps the whole run, only
+    /// the first writes (outputs, snapshots, checkpoints), and a stop signal seen by any of
+    /// them stops all of them after the same step.
+    MPI_Comm ranks = MPI_COMM_SELF;
   };
 
   /// Run @p sim to its end into @p settings.dir (statistics.csv, fields/, summary.json

@@ -21,6 +21,9 @@ namespace
 Usage:
   tribo run CASE.prm [--output DIR] [--set "Subsection/Entry=value" ...] [--quiet]
       Run a case; outputs go to DIR (default output/<case name>), see docs/outputs.md.
+  mpirun -np N tribo run CASE.prm ...
+      One disc case on N ranks: each step's contact solve split into N horizontal bands
+      (Solver/Method = apgs; no deformable first body); rank 0 writes (docs/scaling.md).
   tribo run CASE.prm --resume DIR [--set ...] [--quiet]
       Continue the run in DIR from its checkpoint.bin (Output/Checkpoint interval); only
       Solver/*, Output/*, Simulation/End time and Shear cell/Upper body prediction depth
@@ -55,6 +58,15 @@ Exit codes: 0 success, 1 the run failed, 2 bad input, 128+N interrupted by signa
       if (const char *value = std::getenv(name))
         return std::max(1, std::atoi(value));
     return 1;
+  }
+
+  /// This process's rank among them (0 without a launcher): only the first reports errors.
+  int launched_rank()
+  {
+    for (const char *name : {"OMPI_COMM_WORLD_RANK", "PMI_RANK"})
+      if (const char *value = std::getenv(name))
+        return std::atoi(value);
+    return 0;
   }
 } // namespace
 
@@ -166,22 +178,25 @@ int main(int argc, char **argv)
         }
       if (o.case_file.empty())
         usage_error("'tribo " + args[0] + "' needs a case file");
-      if (const int ranks = launched_ranks(); ranks > 1 && !o.check_only)
-        throw tribo::InputError("'tribo run' was started on " + std::to_string(ranks) +
-                                " MPI ranks: a case runs in one process (only its contact solve is "
-                                "distributed yet, docs/scaling.md), and " + std::to_string(ranks) +
-                                " copies would write one output directory; run it without mpirun, "
-                                "or spread cases over ranks with 'tribo study'");
+      if (launched_ranks() > 1 && !o.check_only)
+        {
+          // One case on every rank: its contact solve split over them (docs/scaling.md).
+          dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv);
+          o.ranks = MPI_COMM_WORLD;
+          return tribo::app::run_case(o);
+        }
       return tribo::app::run_case(o);
     }
   catch (const tribo::InputError &e)
     {
-      std::cerr << "error: " << e.what() << std::endl;
+      if (launched_rank() == 0)
+        std::cerr << "error: " << e.what() << std::endl;
       return tribo::exit_input_error;
     }
   catch (const std::exception &e)
     {
-      std::cerr << "error: " << e.what() << std::endl;
+      if (launched_rank() == 0)
+        std::cerr << "error: " << e.what() << std::endl;
       return tribo::exit_run_error;
     }
 }

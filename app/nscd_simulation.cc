@@ -2,7 +2,9 @@
 
 #include "app/sample_file.h"
 #include "app/scene.h"
+#include "core/errors.h"
 #include "core/output.h"
+#include "dem/parallel/solve_across_ranks.h"
 #include "dem/solvers/methods.h"
 
 #include <boost/archive/binary_iarchive.hpp>
@@ -122,6 +124,16 @@ namespace tribo::app
         solver.gap_target            = p.solver.relative_gap_target * system.min_radius();
         mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
         scene->attach(*mj);
+        if (const unsigned int ranks = rank_count(p.ranks); ranks > 1)
+          {
+            if (mj->n_boundary_bodies() > 0)
+              throw InputError("this case has a deformable first body, which is not split over MPI "
+                               "ranks (docs/scaling.md): run it without mpirun");
+            mj->use_solver(std::make_unique<dem::parallel::SolveAcrossRanks>(solver, system, p.ranks));
+            log("the contact solve of each step split over " + std::to_string(ranks) +
+                " MPI ranks (horizontal bands, APGS's sweeps on each); every rank detects and "
+                "updates the whole system, rank 0 writes (docs/scaling.md)");
+          }
         world.integrator = mj.get();
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
         // A run that goes on from an initial state starts at its step (a whole number of

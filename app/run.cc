@@ -10,6 +10,7 @@
 #include "core/run_control.h"
 #include "core/serialization.h"
 #include "coupling/first_body_models.h"
+#include "dem/solvers/methods.h"
 
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
@@ -133,7 +134,10 @@ namespace tribo::app
     file.parse(o.case_file);
     for (const auto &s : o.overrides)
       file.set(s);
-    const CaseParameters p = read_case_parameters(file);
+    CaseParameters p = read_case_parameters(file);
+    p.ranks          = o.ranks;
+    const unsigned int ranks  = rank_count(o.ranks);
+    const bool         writes = rank_in(o.ranks) == 0;
     // The scene's own entries are checked before anything is written, and its paths made
     // absolute in parameters.prm: a resumed run, or one started from it elsewhere, finds them.
     const SceneEntry &scene = scene_named(p.scene);
@@ -144,6 +148,13 @@ namespace tribo::app
       scene.hooks.check(file);
     if (scene.hooks.resolve)
       scene.hooks.resolve(file);
+    if (ranks > 1 && !scene.build_option.empty())
+      throw InputError(o.case_file + ": Simulation/Scene = " + p.scene + " runs in one process; only the disc "
+                       "scenes split their contact solve over MPI ranks (docs/scaling.md): run it without mpirun");
+    if (ranks > 1 && p.solver.method != dem::SolverParameters::Method::apgs)
+      throw InputError(o.case_file + ": " + p.solver.section.entry("Method") + " = " + dem::method_name(p.solver.method) +
+                       ": on " + std::to_string(ranks) + " MPI ranks the contact solve is APGS's sweeps split into "
+                       "bands (docs/scaling.md); set it to apgs, or run the case without mpirun");
     if (o.check_only)
       {
         if (!o.quiet)
@@ -179,7 +190,7 @@ namespace tribo::app
           changes = resume_changes(saved, file, o.resume_dir);
         },
         false);
-    if (!resuming)
+    if (!resuming && writes)
       try
         {
           fs::create_directories(dir / "fields");
@@ -199,16 +210,18 @@ namespace tribo::app
     JsonObject summary;
     summary.set("status", "running");
     summary.set("case", o.case_file);
-    atomic_write((dir / "summary.json").string(), summary.to_string());
-    atomic_write((dir / "original.prm").string(), file.original_text());
-    {
-      std::ostringstream os;
-      prm.print_parameters(os, dealii::ParameterHandler::PRM);
-      atomic_write((dir / "parameters.prm").string(), os.str());
-    }
+    if (writes)
+      {
+        atomic_write((dir / "summary.json").string(), summary.to_string());
+        atomic_write((dir / "original.prm").string(), file.original_text());
+        std::ostringstream os;
+        prm.print_parameters(os, dealii::ParameterHandler::PRM);
+        atomic_write((dir / "parameters.prm").string(), os.str());
+      }
 
+    // The other ranks of a case run on several log nothing.
     Log log;
-    log.open((dir / "log.txt").string(), !o.quiet);
+    log.open(writes ? (dir / "log.txt").string() : std::string(), writes && !o.quiet);
     log("tribo run " + o.case_file + " -> " + dir.string());
 
     RunCheckpoint checkpoint(dir.string(), resolved, p.checkpoint_interval, p.checkpoint_step_interval,
@@ -224,15 +237,17 @@ namespace tribo::app
       {
         summary.set("status", "failed");
         summary.set("error", e.what());
-        atomic_write((dir / "summary.json").string(), summary.to_string());
+        if (writes)
+          atomic_write((dir / "summary.json").string(), summary.to_string());
         log(std::string("error: ") + e.what());
         throw;
       }
     DriverSettings settings;
     settings.scene      = p.scene;
     settings.dir        = dir.string();
-    settings.quiet      = o.quiet;
+    settings.quiet      = o.quiet || !writes;
     settings.parameters = resolved;
+    settings.ranks      = o.ranks;
     return drive(*simulation, settings, summary, log, checkpoint);
   }
 

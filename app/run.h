@@ -4,6 +4,8 @@
 
 #include "core/checkpoint.h"
 
+#include <mpi.h>
+
 #include <chrono>
 #include <functional>
 #include <map>
@@ -28,6 +30,9 @@ namespace tribo::app
     /// Resume the run whose outputs are in this directory from its checkpoint.bin
     /// (the outputs go on there); empty: a new run.
     std::string              resume_dir;
+    /// The MPI ranks the case runs on (CaseParameters::ranks); all of them call run_case(),
+    /// the first writes.
+    MPI_Comm ranks = MPI_COMM_SELF;
   };
 
   /// Run (or only check) a case; returns the process exit code. Input errors

@@ -125,10 +125,12 @@ namespace tribo
 
   void Log::open(const std::string &path, bool echo_to_terminal)
   {
+    echo = echo_to_terminal;
+    if (path.empty())
+      return;
     file.open(path, std::ios::app);
     if (!file)
       throw RunError("cannot write " + path);
-    echo = echo_to_terminal;
   }
 
   void Log::operator()(const std::string &message)
@@ -142,7 +144,8 @@ namespace tribo
   {
     if (file.is_open())
       file << "error: " << message << '\n' << std::flush;
-    std::cerr << "error: " << message << std::endl;
+    if (file.is_open() || echo)
+      std::cerr << "error: " << message << std::endl;
   }
 
   void TimeSeries::save(CheckpointOut &ar) const

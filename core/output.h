@@ -62,9 +62,11 @@ namespace tribo
   {
   public:
     Log() = default;
+    /// Append to @p path (none: "") and echo to the terminal or not.
     void open(const std::string &path, bool echo_to_terminal);
     void operator()(const std::string &message);
-    /// "error: message" to log.txt and to stderr, quiet or not.
+    /// "error: message" to log.txt and to stderr, quiet or not (a log opened with neither
+    /// a file nor the terminal, another rank's, says nothing).
     void error(const std::string &message);
 
   private:

@@ -114,6 +114,9 @@ namespace tribo::dem
     /// after another in the order of attachment (a resumed run attaches them in the same
     /// order), and their compliances form the blocks of BodyState::node_blocks.
     void attach(BoundaryBody &body, double half_disc_diameter, const Vec2 &outward, double period);
+    /// Solve the steps' contacts with @p other instead of the solver built from the
+    /// SolverParameters (a case on several MPI ranks: dem/parallel/solve_across_ranks.h).
+    void use_solver(std::unique_ptr<ContactSolver> other) { solver = std::move(other); }
     /// The attached bodies, in the order of attachment.
     unsigned int n_boundary_bodies() const { return attached.size(); }
 

@@ -55,8 +55,13 @@ namespace tribo::dem
     void relax(ScaledOperator &op, const ContactLaw &law, const Eigen::VectorXd &b, Eigen::VectorXd &v,
                Eigen::Index j, Eigen::VectorXd *also, double omega = 1) const
     {
+      // Relaxed from an extrapolated (momentum) start, a normal impulse may fall below 0: it
+      // is kept at 0, where impulse() puts it too.
       const auto set = [&](Eigen::Index k, double law_value) {
-        const double next = omega != 1 ? omega * law_value + (1 - omega) * v[k] : law_value;
+        double next = law_value;
+        if (omega != 1)
+          next = k == width * j ? std::max(0.0, omega * law_value + (1 - omega) * v[k])
+                                : omega * law_value + (1 - omega) * v[k];
         if (next != v[k])
           {
             op.add_to_low_rank(k, next - v[k]);

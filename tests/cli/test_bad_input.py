@@ -355,14 +355,6 @@ class CommandLine(BadInputTestCase):
         msg = self.run_bad(["run", "good.prm", "--bogus"])
         self.assert_parts(msg, "unknown option '--bogus'", "tribo --help")
 
-    def test_run_under_mpirun_is_refused_before_writing(self):
-        # N copies of one case would write one output directory; `tribo check` still works.
-        env = dict(os.environ, OMPI_COMM_WORLD_SIZE="3")
-        msg = self.run_bad(["run", "good.prm", "--output", "out"], env=env)
-        self.assert_parts(msg, "'tribo run' was started on 3 MPI ranks", "one output directory",
-                          "without mpirun", "'tribo study'")
-        self.assertEqual(run(["check", "good.prm"], cwd=self.tmp, env=env).returncode, 0)
-
     def test_unknown_command(self):
         msg = self.run_bad(["frobnicate", "good.prm"])
         self.assert_parts(msg, "unknown command 'frobnicate'", "tribo --help")

@@ -1,0 +1,154 @@
+"""One case on several MPI ranks, `mpirun -np N tribo run` (docs/scaling.md):
+
+- on two ranks the 120-disc shear cell gives the serial run's friction, stress, solid fraction
+  and power balance within their combined standard errors, every step within the solver's
+  law residual target, and one set of outputs (rank 0 writes, the others say nothing);
+- a checkpoint written on two ranks (stopped by SIGTERM) resumes on one rank and on three:
+  the rows before the checkpoint are kept bit for bit and both resumed runs complete with
+  the same friction within errors;
+- what is not split over ranks is refused with the cause and the remedy: another solver
+  method (before anything is written), a deal.II first body (the summary says failed).
+
+Usage: /usr/bin/python3 test_ranks.py /path/to/tribo
+"""
+
+import csv
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import tribo_cli  # noqa: E402
+from tribo_cli import TempDirTestCase, read_json, run, write_prm  # noqa: E402
+
+#: cases/shear/small.prm without plots: 120 discs, 8000 steps, APGS to a law residual of 3e-3.
+TARGET = 3e-3
+CASE = {
+    "Simulation": {"Scene": "shear", "Time step": "2e-9", "End time": "1.6e-5"},
+    "Contact law": {"Law": "IQS", "Cohesion range": "2.4e-8"},
+    "Solver": {"Residual target": str(TARGET)},
+    "Shear cell": {"Number of discs": "120", "Length": "1.2e-5", "Wall discs": "0", "Pressure": "1e8",
+                   "Pressure ramp time": "1e-6", "Sliding velocity": "5", "Shear start": "3e-6",
+                   "Profile samples": "3000"},
+    "Output": {"Field interval": "0", "Plots": "false"},
+}
+MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def mpirun(ranks, args):
+    """`tribo ARGS` on @p ranks MPI ranks (oversubscribed: two cores test correctness here)."""
+    launcher = shutil.which("mpirun")
+    assert launcher, "mpirun (openmpi-bin) is installed by scripts/install-deps"
+    return [launcher, "-np", str(ranks), "--oversubscribe", tribo_cli.TRIBO] + list(args)
+
+
+def statistics(path):
+    with open(os.path.join(path, "statistics.csv")) as f:
+        return list(csv.reader(f))
+
+
+class Ranks(TempDirTestCase):
+    def setUp(self):
+        super().setUp()
+        write_prm(os.path.join(self.tmp, "case.prm"), CASE)
+
+    def run_ranks(self, ranks, args, timeout=300):
+        return subprocess.run(mpirun(ranks, args), cwd=self.tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              universal_newlines=True, timeout=timeout, env=MPI_ENV)
+
+    def assert_within_errors(self, a, b, name, errors=2):
+        ra, rb = a["results"], b["results"]
+        mean = name + "_mean" if name + "_mean" in ra else name
+        combined = math.hypot(ra[name + "_stderr"], rb[name + "_stderr"])
+        self.assertLess(abs(ra[mean] - rb[mean]), errors * combined,
+                        "%s: %g +/- %g against %g +/- %g" % (name, ra[mean], ra[name + "_stderr"],
+                                                             rb[mean], rb[name + "_stderr"]))
+
+    def assert_solved_to_target(self, out):
+        s = read_json(os.path.join(self.tmp, out, "summary.json"))
+        self.assertEqual(s["status"], "complete")
+        self.assertEqual(s["solver_non_converged_steps"], 0)
+        self.assertLessEqual(s["law_residual_max"], TARGET * (1 + 1e-9))
+        self.assertAlmostEqual(s["results"]["power_balance_closure"], 1, delta=1e-3)
+        return s
+
+    def test_two_ranks_give_the_serial_friction_and_one_set_of_outputs(self):
+        r = run(["run", "case.prm", "--output", "one", "--quiet"], self.tmp, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = self.run_ranks(2, ["run", "case.prm", "--output", "two"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        # One log: rank 0's, on the terminal and in log.txt.
+        self.assertEqual(r.stdout.count("tribo run case.prm -> two"), 1, r.stdout)
+        self.assertEqual(r.stdout.count("status complete"), 1, r.stdout)
+        with open(os.path.join(self.tmp, "two", "log.txt")) as f:
+            log = f.read()
+        self.assertEqual(log.count("the contact solve of each step split over 2 MPI ranks"), 1)
+        self.assertEqual(sorted(os.listdir(os.path.join(self.tmp, "one"))),
+                         sorted(os.listdir(os.path.join(self.tmp, "two"))))
+        one, two = self.assert_solved_to_target("one"), self.assert_solved_to_target("two")
+        self.assertEqual(two["steps"], 8000)
+        for name in ("mu", "sigma_xy", "solid_fraction", "power_balance_ratio"):
+            self.assert_within_errors(one, two, name)
+
+    def test_a_checkpoint_on_two_ranks_resumes_on_one_and_on_three(self):
+        args = ["run", "case.prm", "--output", "two", "--quiet", "--set", "Output/Checkpoint step interval=1000"]
+        proc = subprocess.Popen(mpirun(2, args), cwd=self.tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                universal_newlines=True, env=MPI_ENV)
+        checkpoint = os.path.join(self.tmp, "two", "checkpoint.bin")
+        deadline = time.monotonic() + 300
+        while not os.path.exists(checkpoint):
+            self.assertIsNone(proc.poll(), "the run ended before its first checkpoint")
+            self.assertLess(time.monotonic(), deadline, "no checkpoint within 300 s")
+            time.sleep(0.01)
+        time.sleep(0.3)
+        self.assertIsNone(proc.poll(), "the run ended before it could be stopped")
+        proc.send_signal(signal.SIGTERM)  # mpirun passes it on to both ranks
+        proc.communicate(timeout=120)
+        stopped = read_json(os.path.join(self.tmp, "two", "summary.json"))
+        self.assertEqual(stopped["status"], "interrupted")
+        kept = statistics(os.path.join(self.tmp, "two"))
+        last_step = int(float(kept[-1][1]))
+        self.assertGreater(last_step, 0)
+        self.assertLess(last_step, 8000)
+        self.assertTrue(os.path.exists(checkpoint), "the stop writes a checkpoint of its last step")
+
+        shutil.copytree(os.path.join(self.tmp, "two"), os.path.join(self.tmp, "on_one"))
+        shutil.copytree(os.path.join(self.tmp, "two"), os.path.join(self.tmp, "on_three"))
+        r = run(["run", "case.prm", "--resume", "on_one", "--quiet"], self.tmp, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = self.run_ranks(3, ["run", "case.prm", "--resume", "on_three", "--quiet"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        resumed = []
+        for out in ("on_one", "on_three"):
+            s = self.assert_solved_to_target(out)
+            rows = statistics(os.path.join(self.tmp, out))
+            self.assertEqual(rows[:len(kept)], kept, "%s rewrote the rows before the checkpoint" % out)
+            self.assertEqual(int(float(rows[-1][1])), 8000)
+            self.assertFalse(os.path.exists(os.path.join(self.tmp, out, "checkpoint.bin")))
+            resumed.append(s)
+        self.assert_within_errors(resumed[0], resumed[1], "mu")
+
+    def test_what_is_not_split_is_refused_with_the_remedy(self):
+        r = self.run_ranks(2, ["run", "case.prm", "--output", "nlgs", "--set", "Solver/Method=nlgs"])
+        self.assertEqual(r.returncode, 2)
+        self.assertEqual(r.stderr.strip().splitlines().count(
+            "error: case.prm: Solver/Method = nlgs: on 2 MPI ranks the contact solve is APGS's sweeps split into "
+            "bands (docs/scaling.md); set it to apgs, or run the case without mpirun"), 1, r.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, "nlgs")), "nothing is written")
+
+        r = self.run_ranks(2, ["run", "case.prm", "--output", "fem", "--set", "Shear cell/Upper body model=fem"])
+        self.assertEqual(r.returncode, 2, r.stderr)
+        message = ("this case has a deformable first body, which is not split over MPI ranks "
+                   "(docs/scaling.md): run it without mpirun")
+        self.assertEqual(r.stderr.count(message), 1, r.stderr)
+        s = read_json(os.path.join(self.tmp, "fem", "summary.json"))
+        self.assertEqual(s["status"], "failed")
+        self.assertEqual(s["error"], message)
+
+
+if __name__ == "__main__":
+    tribo_cli.main()
