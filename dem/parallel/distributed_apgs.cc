@@ -1,5 +1,6 @@
 #include "dem/parallel/distributed_apgs.h"
 
+#include "dem/solvers/apgs.h"
 #include "dem/solvers/sweep_problem.h"
 
 #include <deal.II/base/mpi.h>
@@ -28,8 +29,26 @@ namespace tribo::dem::parallel
       /// changed on a shared body dv moves b' of the contacts on it by s_j H_j^T dv.
       void sync(const Eigen::VectorXd &v);
       /// The map over every rank's contacts at @p v (exchanged), relative to the mean loaded
-      /// impulse (or, with none loaded, the largest of the ranks' scales).
+      /// impulse (or, with none loaded, the largest of the ranks' scales); each contact's
+      /// map is kept for the polish.
       double relative_map(const Eigen::VectorXd &v);
+      /// APGS's local polish on this rank (dem/solvers/apgs.h): polish_passes passes over
+      /// its contacts whose map is above @p target times the mean loaded impulse of the last
+      /// check and their neighbours up to polish_rings rings away in A' (at most
+      /// polish_fraction of its contacts), @p y changed in place and @p z by the same amount;
+      /// the contacts on grains of two ranks relaxed by @p omega. Then (collective) the
+      /// exchange of the interface contacts' impulses and the map again, recomputed only where
+      /// it changed: the polished contacts' rows of A', the walls' low-rank rows, the interface
+      /// contacts, into @p map. False, with nothing exchanged or changed, when no rank had
+      /// anything to polish.
+      bool polish(Eigen::VectorXd &y, Eigen::VectorXd &z, double target, double omega, double &map);
+      /// Polishes after a check whose map @p map is above @p target, as APGS's: until one
+      /// reaches the target (true: @p y is the answer), no rank has anything to polish, or
+      /// polish_patience polishes in a row have not lowered the map (at most max_polishes).
+      /// @p map becomes the last one; with friction a polished iterate below @p best_map
+      /// becomes the safeguard's @p best.
+      bool polish_to(Eigen::VectorXd &y, Eigen::VectorXd &z, double target, double omega, double &map,
+                     Eigen::VectorXd &best, double &best_map);
       /// Every contact's impulse at @p y: the interface contacts' through one more exchange,
       /// the others' on the grains only this rank holds; the caller's free velocities back.
       void finish(const Eigen::VectorXd &y);
@@ -53,6 +72,13 @@ namespace tribo::dem::parallel
       std::vector<Eigen::Vector2d> sent;         ///< each contact's impulse in the state, N s/m
       BodyState                    others;       ///< the other ranks' velocity changes at the last exchange
       std::vector<Eigen::Vector3d> mine;         ///< the shared bodies' velocities before it
+      std::vector<double>          error;        ///< each contact's map at the last check, N s/m
+      double                       mean_loaded = 0; ///< over all ranks at the last check, N s/m
+      std::vector<Eigen::Index>    local, affected_rows; ///< the polish's contacts, the maps it changed
+      std::vector<char>            marked, affected;
+
+      /// The map over all ranks from error (two reductions), mean_loaded set.
+      double reduced_map(const Eigen::VectorXd &v);
 
       /// The contacts' free velocities without this rank's warm-start impulses (the caller's
       /// kept): u_free,j = u_j(state) - (W_local r_warm)_j.
@@ -72,6 +98,9 @@ namespace tribo::dem::parallel
       , op(sweep_problem.scaled)
       , b(sweep_problem.scaled.b)
       , mine(p.serial_body.size())
+      , error(p.contacts.size(), 0)
+      , marked(p.contacts.size(), 0)
+      , affected(p.contacts.size(), 0)
     {
       // Shared bodies: grains other ranks' contacts touch (ghosts here, exported grains),
       // whose contacts are relaxed with momentum, and the walls with a free degree of
@@ -150,19 +179,26 @@ namespace tribo::dem::parallel
 
     double RankSweeps::relative_map(const Eigen::VectorXd &v)
     {
+      op.set_vector(v);
+      const Eigen::Index w = sweep_problem.width;
+      for (Eigen::Index j = 0; j < Eigen::Index(p.contacts.size()); ++j)
+        error[j] = sweep_problem.contact_map(op, b, v, j, op.row_times(v, w * j) + b[w * j]);
+      return reduced_map(v);
+    }
+
+    double RankSweeps::reduced_map(const Eigen::VectorXd &v)
+    {
       ++report.checks;
       report.reductions += 2;
-      op.set_vector(v);
       const Eigen::Index     w = sweep_problem.width;
       const Eigen::VectorXd &s = sweep_problem.scaled.inv_root;
       double                 worst = 0, loaded[2] = {0, 0};
       for (Eigen::Index j = 0; j < Eigen::Index(p.contacts.size()); ++j)
         {
-          const Eigen::Index k = w * j;
-          worst = std::max(worst, sweep_problem.contact_map(op, b, v, j, op.row_times(v, k) + b[k]));
-          if (v[k] > 0)
+          worst = std::max(worst, error[j]);
+          if (v[w * j] > 0)
             {
-              loaded[0] += v[k] * s[k];
+              loaded[0] += v[w * j] * s[w * j];
               loaded[1] += 1;
             }
         }
@@ -170,7 +206,111 @@ namespace tribo::dem::parallel
       double       global_max[2], global_loaded[2];
       dealii::Utilities::MPI::max(maxima, comm, global_max);
       dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
-      return global_max[0] / (global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : global_max[1]);
+      mean_loaded = global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : global_max[1];
+      return global_max[0] / mean_loaded;
+    }
+
+    bool RankSweeps::polish(Eigen::VectorXd &y, Eigen::VectorXd &z, double target, double omega, double &map)
+    {
+      const Eigen::Index n = Eigen::Index(p.contacts.size()), w = sweep_problem.width;
+      const auto        &A = sweep_problem.scaled.A;
+      const double       threshold = target * mean_loaded;
+      const auto         affect    = [&](Eigen::Index j) {
+        if (!affected[j])
+          {
+            affected[j] = 1;
+            affected_rows.push_back(j);
+          }
+      };
+      local.clear();
+      for (Eigen::Index j = 0; j < n; ++j)
+        if (error[j] > threshold)
+          {
+            marked[j] = 1;
+            local.push_back(j);
+          }
+      const double most      = ApgsSolver::polish_fraction * double(n);
+      std::size_t  last_ring = 0; // local[last_ring, ...) is the outermost ring so far
+      for (unsigned int ring = 0; ring < ApgsSolver::polish_rings && double(local.size()) <= most; ++ring)
+        {
+          const std::size_t inner = local.size();
+          for (std::size_t q = std::exchange(last_ring, inner); q < inner; ++q)
+            for (Eigen::Index k = w * local[q]; k < w * local[q] + w; ++k)
+              for (Eigen::SparseMatrix<double>::InnerIterator a(A, k); a; ++a)
+                if (!marked[a.row() / w])
+                  {
+                    marked[a.row() / w] = 1;
+                    local.push_back(a.row() / w);
+                  }
+        }
+      for (const Eigen::Index j : local)
+        marked[j] = 0;
+      const bool polishing = !local.empty() && double(local.size()) <= most;
+      bool       wall      = false;
+      if (polishing)
+        {
+          std::sort(local.begin(), local.end()); // the sweep's order
+          op.set_vector(y);
+          for (unsigned int pass = 0; pass < ApgsSolver::polish_passes; ++pass)
+            for (const Eigen::Index j : local)
+              sweep_problem.relax(op, law, b, y, j, &z, across[j] ? omega : 1.0);
+          for (const Eigen::Index j : local)
+            {
+              for (Eigen::Index k = w * j; k < w * j + w; ++k)
+                {
+                  for (Eigen::SparseMatrix<double>::InnerIterator a(A, k); a; ++a)
+                    affect(a.row() / w);
+                  wall = wall || op.has_low_rank(k);
+                }
+              affect(j);
+            }
+        }
+      ++report.reductions;
+      if (!dealii::Utilities::MPI::logical_or(polishing, comm))
+        return false;
+      sync(y);
+      if (wall)
+        for (const Eigen::Index k : op.low_rank_row_list())
+          affect(k / w);
+      for (const Eigen::Index j : interface)
+        affect(j);
+      op.set_vector(y);
+      for (const Eigen::Index j : affected_rows)
+        {
+          error[j]    = sweep_problem.contact_map(op, b, y, j, op.row_times(y, w * j) + b[w * j]);
+          affected[j] = 0;
+        }
+      affected_rows.clear();
+      map = reduced_map(y);
+      return true;
+    }
+
+    bool RankSweeps::polish_to(Eigen::VectorXd &y, Eigen::VectorXd &z, double target, double omega, double &map,
+                               Eigen::VectorXd &best, double &best_map)
+    {
+      double       lowest = map;
+      unsigned int stale  = 0;
+      for (unsigned int q = 0; q < DistributedControls::max_polishes && stale < DistributedControls::polish_patience;
+           ++q)
+        {
+          if (!polish(y, z, target, omega, map))
+            break;
+          if (map <= target)
+            return true;
+          if (sweep_problem.width == 2 && map < best_map)
+            {
+              best     = y;
+              best_map = map;
+            }
+          if (map < lowest)
+            {
+              lowest = map;
+              stale  = 0;
+            }
+          else
+            ++stale;
+        }
+      return false;
     }
 
     void RankSweeps::finish(const Eigen::VectorXd &y)
@@ -260,6 +400,11 @@ namespace tribo::dem::parallel
           {
             y.swap(next);
             z = y;
+          }
+        if (check && controls.polish && rank.polish_to(y, z, controls.residual_target, omega, map, best, best_map))
+          {
+            report.converged = true;
+            break;
           }
         if (!check || momentum)
           rank.sync(z);

@@ -25,7 +25,10 @@
 /// friction (the law is not associated) APGS's safeguard: the best iterate of the checks is
 /// kept and returned by a solve that ends above it, and a check that raises the map drops the
 /// momentum (t = 1, the next sweep from the iterate); every rank takes the same decision from
-/// the reduced map. APGS's local polish is not carried over. At the end every contact's
+/// the reduced map. After a check that fails, APGS's local polish on each rank's own
+/// contacts above the target (and two rings of their neighbours), then an exchange and the map
+/// again where it changed (DistributedControls::polish): the tail of a warm start's worst
+/// contacts, which whole sweeps would chase, costs local passes. At the end every contact's
 /// impulse is written, the velocities are exchanged once more, and the report's law residual
 /// is the velocity form's over all ranks (global_law_residual).
 

@@ -30,6 +30,13 @@ namespace tribo::dem::parallel
     /// diverges (the established code's sample on two ranks); 0.5 halves what two ranks
     /// put on one grain at once, and the sweeps are then the one-rank count (docs/scaling.md).
     double interface_relaxation = 0.5;
+    /// DistributedApgs: APGS's local polish after a check that fails (dem/solvers/apgs.h),
+    /// on each rank's own contacts above the target, then an exchange and the map again;
+    /// polishes go on until polish_patience in a row have not lowered the map (at most
+    /// max_polishes). Off: blocks of sweeps only.
+    bool                          polish          = true;
+    static constexpr unsigned int polish_patience = 8;
+    static constexpr unsigned int max_polishes    = 256;
   };
 
   /// What a distributed solve achieved; the same on every rank.
