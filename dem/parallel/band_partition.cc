@@ -17,16 +17,30 @@ namespace tribo::dem::parallel
     const double  inf = std::numeric_limits<double>::infinity();
     p.cut.assign(n + 1, inf);
     p.cut[0] = -inf;
-    std::sort(y.begin(), y.end());
+    // The sorted heights at the quantiles only: y[i] put in place by a selection of the part
+    // above the last one placed (O(n_ranks size) instead of a sort each step).
+    std::size_t placed = 0; // y[0, placed) hold the placed-th smallest heights, y[placed - 1] the largest of them
     for (unsigned int k = 1; k < n; ++k)
       {
         const std::size_t i = y.size() * k / n; // the first height of band k
         if (y.empty())
           p.cut[k] = 0;
         else if (i == 0)
-          p.cut[k] = y.front();
+          p.cut[k] = *std::min_element(y.begin(), y.end());
+        else if (i >= y.size())
+          p.cut[k] = *std::max_element(y.begin(), y.end()) + 1;
         else
-          p.cut[k] = i < y.size() ? 0.5 * (y[i - 1] + y[i]) : y.back() + 1;
+          {
+            if (i >= placed)
+              {
+                std::nth_element(y.begin() + placed, y.begin() + i, y.end());
+                // The largest of y[placed, i), all at most y[i]; y[placed - 1] is at most them.
+                if (i > placed)
+                  std::iter_swap(std::max_element(y.begin() + placed, y.begin() + i), y.begin() + i - 1);
+                placed = i + 1;
+              }
+            p.cut[k] = 0.5 * (y[i - 1] + y[i]);
+          }
       }
     return p;
   }

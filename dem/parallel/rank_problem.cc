@@ -8,10 +8,17 @@ namespace tribo::dem::parallel
 {
   namespace
   {
+    /// Height of disc @p d's centre, m (a grain's without the rotation: the same value).
+    double disc_height(const ParticleSystem &system, unsigned int d)
+    {
+      const Disc &disc = system.discs[d];
+      return disc.offset.x() == 0 && disc.offset.y() == 0 ? system.bodies[disc.body].position.y() : system.disc_centre(d).y();
+    }
+
     /// Height of the midpoint of contact @p c's two disc centres, m.
     double contact_height(const ParticleSystem &system, const Contact &c)
     {
-      return 0.5 * (system.disc_centre(c.disc[0]).y() + system.disc_centre(c.disc[1]).y());
+      return 0.5 * (disc_height(system, c.disc[0]) + disc_height(system, c.disc[1]));
     }
 
     /// Bodies of one disc (grains); the others (clumps) are replicated.
