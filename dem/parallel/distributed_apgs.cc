@@ -72,13 +72,21 @@ namespace tribo::dem::parallel
       std::vector<Eigen::Vector2d> sent;         ///< each contact's impulse in the state, N s/m
       BodyState                    others;       ///< the other ranks' velocity changes at the last exchange
       std::vector<Eigen::Vector3d> mine;         ///< the shared bodies' velocities before it
-      std::vector<double>          error;        ///< each contact's map at the last check, N s/m
+      /// Each contact's map at the last check (N s/m), and the largest of each chunk of
+      /// chunk_size consecutive contacts; this rank's loaded impulses' sum (N s/m) and count.
+      /// A polish updates them where it changed the iterate or the maps.
+      std::vector<double>          error, chunk_worst;
+      double                       loaded_sum = 0, loaded_count = 0;
+      static constexpr Eigen::Index chunk_size = 64;
       double                       mean_loaded = 0; ///< over all ranks at the last check, N s/m
-      std::vector<Eigen::Index>    local, affected_rows; ///< the polish's contacts, the maps it changed
-      std::vector<char>            marked, affected;
+      std::vector<Eigen::Index>    local, affected_rows, dirty_chunks; ///< the polish's contacts, the maps it changed
+      std::vector<char>            marked, affected, dirty;
 
-      /// The map over all ranks from error (two reductions), mean_loaded set.
-      double reduced_map(const Eigen::VectorXd &v);
+      /// Contact @p j's contribution to the loaded impulses at @p v, added with @p sign.
+      void count_loaded(const Eigen::VectorXd &v, Eigen::Index j, double sign);
+      /// The map over all ranks from chunk_worst and the loaded sums (two reductions),
+      /// mean_loaded set.
+      double reduced_map();
 
       /// The contacts' free velocities without this rank's warm-start impulses (the caller's
       /// kept): u_free,j = u_j(state) - (W_local r_warm)_j.
@@ -99,8 +107,10 @@ namespace tribo::dem::parallel
       , b(sweep_problem.scaled.b)
       , mine(p.serial_body.size())
       , error(p.contacts.size(), 0)
+      , chunk_worst((p.contacts.size() + chunk_size - 1) / chunk_size, 0)
       , marked(p.contacts.size(), 0)
       , affected(p.contacts.size(), 0)
+      , dirty(chunk_worst.size(), 0)
     {
       // Shared bodies: grains other ranks' contacts touch (ghosts here, exported grains),
       // whose contacts are relaxed with momentum, and the walls with a free degree of
@@ -180,29 +190,38 @@ namespace tribo::dem::parallel
     double RankSweeps::relative_map(const Eigen::VectorXd &v)
     {
       op.set_vector(v);
-      const Eigen::Index w = sweep_problem.width;
-      for (Eigen::Index j = 0; j < Eigen::Index(p.contacts.size()); ++j)
-        error[j] = sweep_problem.contact_map(op, b, v, j, op.row_times(v, w * j) + b[w * j]);
-      return reduced_map(v);
+      const Eigen::Index w = sweep_problem.width, n = Eigen::Index(p.contacts.size());
+      loaded_sum = loaded_count = 0;
+      for (Eigen::Index c = 0; c < Eigen::Index(chunk_worst.size()); ++c)
+        {
+          chunk_worst[c] = 0;
+          for (Eigen::Index j = c * chunk_size; j < std::min(n, (c + 1) * chunk_size); ++j)
+            {
+              error[j]       = sweep_problem.contact_map(op, b, v, j, op.row_times(v, w * j) + b[w * j]);
+              chunk_worst[c] = std::max(chunk_worst[c], error[j]);
+              count_loaded(v, j, 1);
+            }
+        }
+      return reduced_map();
     }
 
-    double RankSweeps::reduced_map(const Eigen::VectorXd &v)
+    void RankSweeps::count_loaded(const Eigen::VectorXd &v, Eigen::Index j, double sign)
+    {
+      const Eigen::Index k = sweep_problem.width * j;
+      if (v[k] > 0)
+        {
+          loaded_sum += sign * v[k] * sweep_problem.scaled.inv_root[k];
+          loaded_count += sign;
+        }
+    }
+
+    double RankSweeps::reduced_map()
     {
       ++report.checks;
       report.reductions += 2;
-      const Eigen::Index     w = sweep_problem.width;
-      const Eigen::VectorXd &s = sweep_problem.scaled.inv_root;
-      double                 worst = 0, loaded[2] = {0, 0};
-      for (Eigen::Index j = 0; j < Eigen::Index(p.contacts.size()); ++j)
-        {
-          worst = std::max(worst, error[j]);
-          if (v[w * j] > 0)
-            {
-              loaded[0] += v[w * j] * s[w * j];
-              loaded[1] += 1;
-            }
-        }
-      const double maxima[2] = {worst, sweep_problem.scale};
+      const double worst       = chunk_worst.empty() ? 0 : *std::max_element(chunk_worst.begin(), chunk_worst.end());
+      const double maxima[2]   = {worst, sweep_problem.scale};
+      const double loaded[2]   = {loaded_sum, loaded_count};
       double       global_max[2], global_loaded[2];
       dealii::Utilities::MPI::max(maxima, comm, global_max);
       dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
@@ -223,12 +242,14 @@ namespace tribo::dem::parallel
           }
       };
       local.clear();
-      for (Eigen::Index j = 0; j < n; ++j)
-        if (error[j] > threshold)
-          {
-            marked[j] = 1;
-            local.push_back(j);
-          }
+      for (Eigen::Index c = 0; c < Eigen::Index(chunk_worst.size()); ++c)
+        if (chunk_worst[c] > threshold)
+          for (Eigen::Index j = c * chunk_size; j < std::min(n, (c + 1) * chunk_size); ++j)
+            if (error[j] > threshold)
+              {
+                marked[j] = 1;
+                local.push_back(j);
+              }
       const double most      = ApgsSolver::polish_fraction * double(n);
       std::size_t  last_ring = 0; // local[last_ring, ...) is the outermost ring so far
       for (unsigned int ring = 0; ring < ApgsSolver::polish_rings && double(local.size()) <= most; ++ring)
@@ -251,9 +272,13 @@ namespace tribo::dem::parallel
         {
           std::sort(local.begin(), local.end()); // the sweep's order
           op.set_vector(y);
+          for (const Eigen::Index j : local)
+            count_loaded(y, j, -1);
           for (unsigned int pass = 0; pass < ApgsSolver::polish_passes; ++pass)
             for (const Eigen::Index j : local)
               sweep_problem.relax(op, law, b, y, j, &z, across[j] ? omega : 1.0);
+          for (const Eigen::Index j : local)
+            count_loaded(y, j, 1);
           for (const Eigen::Index j : local)
             {
               for (Eigen::Index k = w * j; k < w * j + w; ++k)
@@ -279,9 +304,21 @@ namespace tribo::dem::parallel
         {
           error[j]    = sweep_problem.contact_map(op, b, y, j, op.row_times(y, w * j) + b[w * j]);
           affected[j] = 0;
+          if (!dirty[j / chunk_size])
+            {
+              dirty[j / chunk_size] = 1;
+              dirty_chunks.push_back(j / chunk_size);
+            }
         }
       affected_rows.clear();
-      map = reduced_map(y);
+      for (const Eigen::Index c : dirty_chunks)
+        {
+          chunk_worst[c] = *std::max_element(error.begin() + c * chunk_size,
+                                             error.begin() + std::min(n, (c + 1) * chunk_size));
+          dirty[c]       = 0;
+        }
+      dirty_chunks.clear();
+      map = reduced_map();
       return true;
     }
 
