@@ -155,6 +155,10 @@ namespace tribo::app
       throw InputError(o.case_file + ": " + p.solver.section.entry("Method") + " = " + dem::method_name(p.solver.method) +
                        ": on " + std::to_string(ranks) + " MPI ranks the contact solve is APGS's sweeps split into "
                        "bands (docs/scaling.md); set it to apgs, or run the case without mpirun");
+    if (ranks > 1 && !coupling::is_wall_of_discs(file.get("Shear cell/Upper body model")))
+      throw InputError(o.case_file + ": Shear cell/Upper body model = " + file.get("Shear cell/Upper body model") +
+                       ": a deformable first body is not split over MPI ranks (docs/scaling.md); run the case "
+                       "without mpirun");
     if (o.check_only)
       {
         if (!o.quiet)
