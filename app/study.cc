@@ -1,5 +1,6 @@
 #include "app/study.h"
 
+#include "app/case_parameters.h"
 #include "app/scenes.h"
 #include "app/run.h"
 #include "core/errors.h"
@@ -394,6 +395,33 @@ namespace tribo::app
         }
     }
 
+    /// Whether every case (@p overrides of @p base) and preparation may run on several MPI
+    /// ranks: `tribo check` of each on all of them passes run_case()'s refusals (a Solver/Method
+    /// other than apgs, a scene or first body that is not split).
+    bool every_case_splits(const fs::path &base, const std::vector<std::vector<std::string>> &overrides,
+                           const std::vector<std::vector<std::string>> &preparations)
+    {
+      for (const auto *list : {&overrides, &preparations})
+        for (const auto &o : *list)
+          {
+            RunOptions check;
+            check.case_file  = base.string();
+            check.overrides  = o;
+            check.check_only = true;
+            check.quiet      = true;
+            check.ranks      = MPI_COMM_WORLD;
+            try
+              {
+                run_case(check);
+              }
+            catch (const InputError &)
+              {
+                return false;
+              }
+          }
+      return true;
+    }
+
     /// OUTPUT/STEM_NNN.
     fs::path numbered_dir(const fs::path &dir, const char *stem, std::size_t i)
     {
@@ -406,30 +434,42 @@ namespace tribo::app
     /// the same overrides, or resume it from its checkpoint; false when interrupted by a
     /// signal.
     bool run_into(const fs::path &cd, const fs::path &base, const std::vector<std::string> &overrides,
-                  const std::string &label, bool quiet)
+                  const std::string &label, bool quiet, MPI_Comm ranks)
     {
+      // The case's ranks (one, or a group of them): the first decides and writes.
+      const bool leader = rank_in(ranks) == 0;
       std::string text = "# tribo study: base case " + base.string() + "\n";
       for (const auto &a : overrides)
         text += a + "\n";
-      if (fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == text && run_status(cd.string()) == "complete")
+      const bool same = fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == text;
+      // 0: skip (complete with the same overrides), 1: run, 2: resume from its checkpoint.
+      int what = !same || run_status(cd.string()) != "complete" ? 1 : 0;
+      if (what == 1 && same && fs::exists(cd / "checkpoint.bin") && run_status(cd.string()) != "failed")
+        what = 2;
+      MPI_Bcast(&what, 1, MPI_INT, 0, ranks);
+      if (what == 0)
         {
-          if (!quiet)
+          if (!quiet && leader)
             std::cout << label << ": complete, skipped" << std::endl;
           return true;
         }
-      // A run of this parameter set that stopped with a checkpoint goes on from it.
-      const bool resume = fs::exists(cd / "study.prm") && read_file(cd / "study.prm") == text &&
-                          fs::exists(cd / "checkpoint.bin") && run_status(cd.string()) != "failed";
-      fs::create_directories(cd);
-      atomic_write((cd / "study.prm").string(), text);
+      const bool resume = what == 2;
+      if (leader)
+        {
+          fs::create_directories(cd);
+          atomic_write((cd / "study.prm").string(), text);
+        }
       RunOptions run;
       run.case_file = base.string();
       run.overrides = overrides;
       (resume ? run.resume_dir : run.output_dir) = cd.string();
       run.quiet = true;
-      if (!quiet)
+      run.ranks = ranks;
+      const unsigned int n_ranks = rank_count(ranks);
+      if (!quiet && leader)
         std::cout << label << " (rank " << dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD)
-                  << "): " << (resume ? "resuming" : "running") << std::endl;
+                  << (n_ranks > 1 ? " and " + std::to_string(n_ranks - 1) + " more" : std::string()) << "): "
+                  << (resume ? "resuming" : "running") << std::endl;
       try
         {
           run_case(run);
@@ -437,14 +477,17 @@ namespace tribo::app
       catch (const std::exception &e)
         {
           // Recorded for the table; the other cases go on.
-          JsonObject failed;
-          failed.set("status", "failed");
-          failed.set("error", e.what());
-          atomic_write((cd / "summary.json").string(), failed.to_string());
+          if (leader)
+            {
+              JsonObject failed;
+              failed.set("status", "failed");
+              failed.set("error", e.what());
+              atomic_write((cd / "summary.json").string(), failed.to_string());
+            }
         }
-      if (!quiet)
+      if (!quiet && leader)
         std::cout << label << ": " << run_status(cd.string()) << std::endl;
-      if (stop_requested())
+      if (n_ranks > 1 ? dealii::Utilities::MPI::max(stop_requested(), ranks) : stop_requested())
         {
           // Ctrl-C or SIGTERM: the running case was closed as interrupted; stop here,
           // a rerun resumes from it.
@@ -568,6 +611,21 @@ namespace tribo::app
     if (rank == 0)
       fs::create_directories(dir);
     MPI_Barrier(MPI_COMM_WORLD);
+    // With more ranks than cases, each case runs on a group of ranks, its contact solve split
+    // over them (docs/scaling.md), when every case and preparation can be; otherwise (and in
+    // a tradeoff, whose costs compare one-rank runs) one rank per case. Group g holds the
+    // ranks g, g + groups, ... and runs the cases g, g + groups, ...
+    unsigned int groups = size;
+    if (!study.tradeoff && size > list.overrides.size() && !list.overrides.empty() &&
+        every_case_splits(study.base, list.overrides, shared.preparations))
+      groups = static_cast<unsigned int>(list.overrides.size());
+    MPI_Comm group;
+    MPI_Comm_split(MPI_COMM_WORLD, int(rank % groups), int(rank), &group);
+    const unsigned int g = rank % groups;
+    if (rank == 0 && !o.quiet && groups < size)
+      std::cout << "study: " << size << " MPI ranks for " << list.overrides.size() << " cases: each case on "
+                << size / groups << (size % groups ? " or " + std::to_string(size / groups + 1) : std::string())
+                << " ranks" << std::endl;
     // A case sharing a compaction starts from its state.
     for (std::size_t i = 0; i < list.overrides.size(); ++i)
       if (shared.of_case[i] >= 0)
@@ -578,14 +636,16 @@ namespace tribo::app
       std::cout << "study: " << shared.note << std::endl;
     // The shared compactions first, one per rank at a time, then the cases: rank r takes
     // r, r + size, ...
-    for (std::size_t i = rank; i < shared.preparations.size(); i += size)
+    for (std::size_t i = g; i < shared.preparations.size(); i += groups)
       if (!run_into(numbered_dir(dir, "preparation", i), study.base, shared.preparations[i],
-                    "preparation " + std::to_string(i), o.quiet))
+                    "preparation " + std::to_string(i), o.quiet, group))
         return 128 + stop_requested();
     MPI_Barrier(MPI_COMM_WORLD);
-    for (std::size_t i = rank; i < list.overrides.size(); i += size)
-      if (!run_into(numbered_dir(dir, "case", i), study.base, list.overrides[i], "case " + std::to_string(i), o.quiet))
+    for (std::size_t i = g; i < list.overrides.size(); i += groups)
+      if (!run_into(numbered_dir(dir, "case", i), study.base, list.overrides[i], "case " + std::to_string(i), o.quiet,
+                    group))
         return 128 + stop_requested();
+    MPI_Comm_free(&group);
     MPI_Barrier(MPI_COMM_WORLD);
     if (rank != 0)
       return exit_ok;

@@ -1,7 +1,10 @@
 #pragma once
 /// @file `tribo study STUDY.prm`: every combination of lists of parameter values
 /// run as cases of one base case, one case per MPI rank at a time (or one after
-/// another without mpirun), resumable, summarised in one table.
+/// another without mpirun), resumable, summarised in one table. With more ranks than
+/// cases (and no tradeoff design), each case runs on a group of ranks, its contact solve
+/// split over them (docs/scaling.md), when every case can be split (Solver/Method = apgs, a
+/// disc scene, no deformable first body); otherwise one rank per case still.
 ///
 /// A study file:
 ///

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """`tribo study`: two cases over two MPI ranks give the same summary rows as one after
-another; an interrupted study resumes without redoing finished cases; changed fixed
+another; with four ranks each case runs on two (unless a case cannot be split); an interrupted study resumes without redoing finished cases; changed fixed
 parameters never mix with old results; bad study input fails before anything runs.
 `tribo tradeoff` (Design = tradeoff): the reference and each ladder's rungs are run,
 and tradeoff.csv holds the cost and the errors against the reference, recomputed here
@@ -113,6 +113,22 @@ class Study(WithBaseCase):
         self.assertEqual([r["status"] for r in serial], ["complete", "complete"])
         self.assertEqual(serial, parallel)  # bit-identical physics, whatever the rank
         self.assertNotEqual(serial[0]["mu_mean"], serial[1]["mu_mean"])  # two different cases
+
+    def test_more_ranks_than_cases_give_each_case_several(self):
+        self.study("serial")
+        log = self.study("four", mpi_ranks=4)
+        self.assertIn("study: 4 MPI ranks for 2 cases: each case on 2 ranks", log)
+        self.assertIn("case 1 (rank 1 and 1 more): running", log)
+        for case in ("case_000", "case_001"):
+            with open(os.path.join(self.dir, "four", case, "log.txt")) as f:
+                self.assertEqual(f.read().count("the contact solve of each step split over 2 MPI ranks"), 1)
+        # 50 discs: under 64 contacts per rank a step is solved whole on every rank, the serial bits.
+        self.assertEqual(table(os.path.join(self.dir, "serial")), table(os.path.join(self.dir, "four")))
+        # A study whose cases cannot be split runs one case per rank.
+        self.write_study("; Solver/Method = nlgs")
+        log = self.study("nlgs", mpi_ranks=4)
+        self.assertNotIn("each case on", log)
+        self.assertIn("case 1 (rank 1): running", log)
 
     def test_interrupted_study_resumes_without_redoing_finished_cases(self):
         out = os.path.join(self.dir, "s")
