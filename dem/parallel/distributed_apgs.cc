@@ -250,22 +250,8 @@ namespace tribo::dem::parallel
                 marked[j] = 1;
                 local.push_back(j);
               }
-      const double most      = ApgsSolver::polish_fraction * double(n);
-      std::size_t  last_ring = 0; // local[last_ring, ...) is the outermost ring so far
-      for (unsigned int ring = 0; ring < ApgsSolver::polish_rings && double(local.size()) <= most; ++ring)
-        {
-          const std::size_t inner = local.size();
-          for (std::size_t q = std::exchange(last_ring, inner); q < inner; ++q)
-            for (Eigen::Index k = w * local[q]; k < w * local[q] + w; ++k)
-              for (Eigen::SparseMatrix<double>::InnerIterator a(A, k); a; ++a)
-                if (!marked[a.row() / w])
-                  {
-                    marked[a.row() / w] = 1;
-                    local.push_back(a.row() / w);
-                  }
-        }
-      for (const Eigen::Index j : local)
-        marked[j] = 0;
+      const double most = ApgsSolver::polish_fraction * double(n);
+      sweep_problem.add_rings(local, marked, ApgsSolver::polish_rings, most);
       const bool polishing = !local.empty() && double(local.size()) <= most;
       bool       wall      = false;
       if (polishing)

@@ -251,22 +251,7 @@ namespace tribo::dem
                 marked[j] = 1;
                 local.push_back(j);
               }
-      std::size_t last_ring = 0; // local[last_ring, ...) is the outermost ring so far
-      for (unsigned int ring = 0;
-           ring < ApgsSolver::polish_rings && double(local.size()) <= ApgsSolver::polish_fraction * double(n); ++ring)
-        {
-          const std::size_t inner = local.size();
-          for (std::size_t q = std::exchange(last_ring, inner); q < inner; ++q)
-            for (Eigen::Index k = w * local[q]; k < w * local[q] + w; ++k)
-              for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, k); a; ++a)
-                if (!marked[a.row() / w])
-                  {
-                    marked[a.row() / w] = 1;
-                    local.push_back(a.row() / w);
-                  }
-        }
-      for (const Eigen::Index j : local)
-        marked[j] = 0;
+      problem.add_rings(local, marked, ApgsSolver::polish_rings, ApgsSolver::polish_fraction * double(n));
       std::sort(local.begin(), local.end()); // the sweep's order
       if (local.empty() || double(local.size()) > ApgsSolver::polish_fraction * double(n))
         return false;

@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace tribo::dem
@@ -102,6 +103,27 @@ namespace tribo::dem
 
     /// Contact @p i's impulse (r_n, r_t) at @p y (scaled), r_n = max(0, x_n) - gamma h,
     /// r_t = x_t (0 without friction), N s/m.
+    /// The polish's neighbourhood: @p local (contacts, each marked in @p marked) grown by the
+    /// contacts up to @p rings rings away in A' (ring 1: the rows of their columns) while it
+    /// holds at most @p most contacts; the marks are cleared again.
+    void add_rings(std::vector<Eigen::Index> &local, std::vector<char> &marked, unsigned int rings, double most) const
+    {
+      std::size_t last_ring = 0; // local[last_ring, ...) is the outermost ring so far
+      for (unsigned int ring = 0; ring < rings && double(local.size()) <= most; ++ring)
+        {
+          const std::size_t inner = local.size();
+          for (std::size_t q = std::exchange(last_ring, inner); q < inner; ++q)
+            for (Eigen::Index k = width * local[q]; k < width * local[q] + width; ++k)
+              for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, k); a; ++a)
+                if (!marked[a.row() / width])
+                  {
+                    marked[a.row() / width] = 1;
+                    local.push_back(a.row() / width);
+                  }
+        }
+      for (const Eigen::Index j : local)
+        marked[j] = 0;
+    }
     Eigen::Vector2d impulse(const Eigen::VectorXd &y, Eigen::Index i) const
     {
       const Eigen::Index k = width * i;
