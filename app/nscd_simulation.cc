@@ -36,7 +36,7 @@ namespace tribo::app
     struct StepTiming
     {
       unsigned long steps = 0, sweeps = 0, check_passes = 0;
-      double        step = 0, detection = 0, boundary_body = 0, solver = 0;
+      double        step = 0, detection = 0, boundary_body = 0, solver = 0, exchange = 0;
       /// Sum over steps of (sweeps + check passes) x contacts: a check pass solves every
       /// contact's law like a sweep.
       double contact_updates = 0;
@@ -50,6 +50,7 @@ namespace tribo::app
         detection += r.time_detection;
         boundary_body += r.time_boundary_body;
         solver += r.time_solver;
+        exchange += r.solver.time_exchange;
         contact_updates += double(r.solver.iterations + r.solver.check_passes) * r.n_contacts;
       }
 
@@ -63,6 +64,7 @@ namespace tribo::app
         j.set("detection_mean_s", detection / n);
         j.set("boundary_body_mean_s", boundary_body / n);
         j.set("solver_mean_s", solver / n);
+        j.set("exchange_mean_s", exchange / n); // part of solver_mean_s
         j.set("other_mean_s", (step - detection - boundary_body - solver) / n);
         j.set("solver_iterations_mean", double(sweeps) / n);
         j.set("solver_check_passes_mean", double(check_passes) / n);

@@ -223,8 +223,11 @@ namespace tribo::dem::parallel
       const double maxima[2]   = {worst, sweep_problem.scale};
       const double loaded[2]   = {loaded_sum, loaded_count};
       double       global_max[2], global_loaded[2];
-      dealii::Utilities::MPI::max(maxima, comm, global_max);
-      dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
+      {
+        const CommunicationTime timed(report);
+        dealii::Utilities::MPI::max(maxima, comm, global_max);
+        dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
+      }
       mean_loaded = global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : global_max[1];
       return global_max[0] / mean_loaded;
     }
@@ -277,7 +280,12 @@ namespace tribo::dem::parallel
             }
         }
       ++report.reductions;
-      if (!dealii::Utilities::MPI::logical_or(polishing, comm))
+      bool anyone_polishing = false;
+      {
+        const CommunicationTime timed(report);
+        anyone_polishing = dealii::Utilities::MPI::logical_or(polishing, comm);
+      }
+      if (!anyone_polishing)
         return false;
       sync(y);
       if (wall)
@@ -405,7 +413,11 @@ namespace tribo::dem::parallel
             double opposed = 0;
             for (Eigen::Index k = 0; k < rows; ++k)
               opposed += (z[k] - next[k]) * (next[k] - y[k]);
-            if (dealii::Utilities::MPI::sum(opposed, comm) > 0)
+            {
+              const CommunicationTime timed(report);
+              opposed = dealii::Utilities::MPI::sum(opposed, comm);
+            }
+            if (opposed > 0)
               t = 1;
             const double t_next = 0.5 * (1 + std::sqrt(1 + 4 * t * t));
             const double beta   = (t - 1) / t_next;

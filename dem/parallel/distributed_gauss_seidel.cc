@@ -68,7 +68,11 @@ namespace tribo::dem::parallel
         if (momentum)
           {
             ++report.reductions;
-            if (dealii::Utilities::MPI::sum(opposing, comm) > 0)
+            {
+              const CommunicationTime timed(report);
+              opposing = dealii::Utilities::MPI::sum(opposing, comm);
+            }
+            if (opposing > 0)
               t = 1;
             const double t_next = 0.5 * (1 + std::sqrt(1 + 4 * t * t));
             const double beta   = (t - 1) / t_next;

@@ -70,6 +70,7 @@ namespace tribo::dem::parallel
 
   void GrainExchange::exchange(BodyState &state, DistributedReport &report)
   {
+    const CommunicationTime timed(report);
     auto             &v           = vector->v;
     const auto       &partitioner = *v.get_partitioner();
     const unsigned    first_rep   = n_owned + n_ghost, n_rep = n_local - first_rep;
@@ -113,8 +114,11 @@ namespace tribo::dem::parallel
     const double      loaded[2] = {local.mean_impulse * local.loaded, double(local.loaded)};
     const double      maxima[2] = {local.max_phi, local.gap_violation};
     double            global_max[2], global_loaded[2];
-    dealii::Utilities::MPI::max(maxima, comm, global_max);
-    dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
+    {
+      const CommunicationTime timed(report);
+      dealii::Utilities::MPI::max(maxima, comm, global_max);
+      dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
+    }
     const double mean    = global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : 0;
     report.law_residual  = mean > 0 ? global_max[0] / mean : (global_max[0] > 0 ? 1 : 0);
     report.gap_violation = global_max[1];

@@ -8,6 +8,7 @@
 
 #include <mpi.h>
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -54,6 +55,30 @@ namespace tribo::dem::parallel
     std::uint64_t bytes_sent = 0;
     unsigned int  reductions = 0;
     unsigned int  neighbours = 0; ///< ranks it exchanges with
+    /// Wall time this rank spent in the exchanges and the sums over the ranks, waits for the
+    /// other ranks included, s.
+    double time_communication = 0;
+  };
+
+  /// Adds the wall time from its construction to its destruction to
+  /// DistributedReport::time_communication: put around an exchange or a sum over the ranks.
+  class CommunicationTime
+  {
+  public:
+    explicit CommunicationTime(DistributedReport &report)
+      : report(report)
+      , start(std::chrono::steady_clock::now())
+    {}
+    ~CommunicationTime()
+    {
+      report.time_communication += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    CommunicationTime(const CommunicationTime &)            = delete;
+    CommunicationTime &operator=(const CommunicationTime &) = delete;
+
+  private:
+    DistributedReport                    &report;
+    std::chrono::steady_clock::time_point start;
   };
 
   /// The exchange of a RankProblem's shared bodies' velocities after local changes:

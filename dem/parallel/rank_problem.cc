@@ -34,17 +34,28 @@ namespace tribo::dem::parallel
     }
   } // namespace
 
+  std::vector<double> contact_heights(const ParticleSystem &system, const std::vector<Contact> &contacts)
+  {
+    std::vector<double> y(contacts.size());
+    for (std::size_t i = 0; i < contacts.size(); ++i)
+      y[i] = contact_height(system, contacts[i]);
+    return y;
+  }
+
   BandPartition contact_bands(const ParticleSystem &system, const std::vector<Contact> &contacts, unsigned int n)
   {
-    std::vector<double> y;
-    y.reserve(contacts.size());
-    for (const Contact &c : contacts)
-      y.push_back(contact_height(system, c));
-    return BandPartition::balanced(std::move(y), n);
+    return BandPartition::balanced(contact_heights(system, contacts), n);
   }
 
   RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts, const BodyState &state,
                        const BandPartition &bands, unsigned int rank)
+  {
+    return share_of(system, contacts, contact_heights(system, contacts), state, bands, rank);
+  }
+
+  RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts,
+                       const std::vector<double> &heights, const BodyState &state, const BandPartition &bands,
+                       unsigned int rank)
   {
     const std::size_t       n_bodies = system.bodies.size();
     const std::vector<bool> grain    = grains_of(system);
@@ -72,7 +83,7 @@ namespace tribo::dem::parallel
         if (c.on_boundary())
           throw RunError("a contact with a half-disc element: a deformable first body is not yet "
                          "distributed over MPI ranks (dem/parallel/README.md)");
-        if (bands.band_of(contact_height(system, c)) != rank)
+        if (bands.band_of(heights[i]) != rank)
           continue;
         p.serial_contact.push_back(static_cast<unsigned int>(i));
         touched[c.body[0]] = touched[c.body[1]] = true;
@@ -94,6 +105,9 @@ namespace tribo::dem::parallel
       p.serial_body.insert(p.serial_body.end(), list->begin(), list->end());
 
     std::vector<unsigned int> local(n_bodies, 0);
+    p.state.velocity.reserve(p.serial_body.size());
+    p.state.inverse_mass.reserve(p.serial_body.size());
+    p.global_grain.reserve(p.n_owned + p.n_ghost);
     for (unsigned int l = 0; l < p.serial_body.size(); ++l)
       {
         const unsigned int b = p.serial_body[l];
@@ -103,12 +117,12 @@ namespace tribo::dem::parallel
         if (l < p.n_owned + p.n_ghost)
           p.global_grain.push_back(global[b]);
       }
-    for (const unsigned int i : p.serial_contact)
+    p.contacts.resize(p.serial_contact.size());
+    for (std::size_t k = 0; k < p.contacts.size(); ++k)
       {
-        Contact c = contacts[i];
-        c.body[0] = local[c.body[0]];
-        c.body[1] = local[c.body[1]];
-        p.contacts.push_back(c);
+        Contact &c = p.contacts[k] = contacts[p.serial_contact[k]];
+        c.body[0]  = local[c.body[0]];
+        c.body[1]  = local[c.body[1]];
       }
     return p;
   }

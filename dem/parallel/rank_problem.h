@@ -38,6 +38,8 @@ namespace tribo::dem::parallel
     unsigned int n_replicated() const { return static_cast<unsigned int>(serial_body.size()) - n_owned - n_ghost; }
   };
 
+  /// The height of each contact's midpoint between its two disc centres, m.
+  std::vector<double> contact_heights(const ParticleSystem &system, const std::vector<Contact> &contacts);
   /// Bands of equal contact counts for @p n ranks, by the contacts' midpoint heights.
   BandPartition contact_bands(const ParticleSystem &system, const std::vector<Contact> &contacts, unsigned int n);
 
@@ -47,4 +49,8 @@ namespace tribo::dem::parallel
   /// deformable first body is not yet distributed).
   RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts, const BodyState &state,
                        const BandPartition &bands, unsigned int rank);
+  /// The same, with the contacts' @p heights (contact_heights) already computed.
+  RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts,
+                       const std::vector<double> &heights, const BodyState &state, const BandPartition &bands,
+                       unsigned int rank);
 } // namespace tribo::dem::parallel

@@ -1,26 +1,30 @@
 #include "dem/parallel/solve_across_ranks.h"
 
+#include "dem/parallel/all_gather.h"
 #include "dem/parallel/distributed_apgs.h"
 #include "dem/parallel/rank_problem.h"
 
 #include <deal.II/base/mpi.h>
 
+#include <chrono>
+#include <cstdint>
+
 namespace tribo::dem::parallel
 {
   namespace
   {
-    /// Every rank's @p mine concatenated in rank order, on every rank (MPI_Allgatherv).
-    std::vector<double> gathered(const std::vector<double> &mine, MPI_Comm comm)
+    /// A contact's impulse from its owner (its serial index, N s/m).
+    struct ImpulseRecord
     {
-      const int        size  = static_cast<int>(mine.size());
-      std::vector<int> sizes = dealii::Utilities::MPI::all_gather(comm, size);
-      std::vector<int> offsets(sizes.size() + 1, 0);
-      for (std::size_t k = 0; k < sizes.size(); ++k)
-        offsets[k + 1] = offsets[k] + sizes[k];
-      std::vector<double> all(offsets.back());
-      MPI_Allgatherv(mine.data(), size, MPI_DOUBLE, all.data(), sizes.data(), offsets.data(), MPI_DOUBLE, comm);
-      return all;
-    }
+      std::uint32_t contact;
+      double        r[2];
+    };
+    /// A grain's velocity from its owner (its serial body index; m/s and rad/s).
+    struct VelocityRecord
+    {
+      std::uint32_t body;
+      double        v[3];
+    };
   } // namespace
 
   SolveAcrossRanks::SolveAcrossRanks(const SolverParameters &p, const ParticleSystem &system, MPI_Comm comm)
@@ -42,32 +46,36 @@ namespace tribo::dem::parallel
     if (contacts.size() < std::size_t(min_contacts_per_rank) * ranks)
       return whole->solve(contacts, state, law, theta_h);
 
-    RankProblem problem = share_of(system, contacts, state, contact_bands(system, contacts, ranks),
+    const auto                since   = [](const auto &start) {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    auto                      start   = std::chrono::steady_clock::now();
+    const std::vector<double> heights = contact_heights(system, contacts);
+    RankProblem problem = share_of(system, contacts, heights, state, BandPartition::balanced(heights, ranks),
                                    dealii::Utilities::MPI::this_mpi_process(comm));
+    DistributedApgs apgs(problem, comm);
+    const double    divide = since(start);
     DistributedControls controls;
-    controls.residual_target = prm.residual_target;
-    controls.max_sweeps      = prm.max_iterations;
-    const DistributedReport done = DistributedApgs(problem, comm).solve(problem, law, controls, theta_h);
+    controls.residual_target     = prm.residual_target;
+    controls.max_sweeps          = prm.max_iterations;
+    const DistributedReport done = apgs.solve(problem, law, controls, theta_h);
+    start                        = std::chrono::steady_clock::now();
 
-    // Each owned contact's impulse and each owned grain's velocity, as records
-    // (serial index, values), to every rank.
-    std::vector<double> mine;
-    mine.reserve(3 * problem.contacts.size());
-    for (std::size_t i = 0; i < problem.contacts.size(); ++i)
-      mine.insert(mine.end(), {double(problem.serial_contact[i]), problem.contacts[i].r[0], problem.contacts[i].r[1]});
-    const std::vector<double> impulses = gathered(mine, comm);
-    for (std::size_t k = 0; k < impulses.size(); k += 3)
-      contacts[std::size_t(impulses[k])].r = {impulses[k + 1], impulses[k + 2]};
+    // Each owned contact's impulse and each owned grain's velocity, to every rank.
+    std::vector<ImpulseRecord> impulses(problem.contacts.size());
+    for (std::size_t i = 0; i < impulses.size(); ++i)
+      impulses[i] = {problem.serial_contact[i], {problem.contacts[i].r[0], problem.contacts[i].r[1]}};
+    for (const ImpulseRecord &record : all_gathered(impulses, comm))
+      contacts[record.contact].r = {record.r[0], record.r[1]};
 
-    mine.clear();
+    std::vector<VelocityRecord> velocities(problem.n_owned);
     for (unsigned int l = 0; l < problem.n_owned; ++l)
       {
         const Eigen::Vector3d &v = problem.state.velocity[l];
-        mine.insert(mine.end(), {double(problem.serial_body[l]), v[0], v[1], v[2]});
+        velocities[l]            = {problem.serial_body[l], {v[0], v[1], v[2]}};
       }
-    const std::vector<double> velocities = gathered(mine, comm);
-    for (std::size_t k = 0; k < velocities.size(); k += 4)
-      state.velocity[std::size_t(velocities[k])] = {velocities[k + 1], velocities[k + 2], velocities[k + 3]};
+    for (const VelocityRecord &record : all_gathered(velocities, comm))
+      state.velocity[record.body] = {record.v[0], record.v[1], record.v[2]};
 
     // The walls: the sums over the ranks may differ in their last bits from rank to rank.
     std::vector<double> walls;
@@ -78,6 +86,7 @@ namespace tribo::dem::parallel
       state.velocity[problem.serial_body[l]] = {walls[k], walls[k + 1], walls[k + 2]};
 
     SolveReport report;
+    report.time_exchange = divide + done.time_communication + since(start);
     report.iterations    = done.sweeps;
     report.check_passes  = done.checks;
     report.law_residual  = done.law_residual;

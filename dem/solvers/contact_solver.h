@@ -167,6 +167,11 @@ namespace tribo::dem
     /// Largest gap violation theta h max(0, -(u_n + shift)) over the IQS contacts at
     /// the last check, m (0 for ELAS, whose law has no hard constraint).
     double gap_violation = 0;
+    /// Of the solve's wall time on several MPI ranks (dem/parallel/solve_across_ranks.h), s:
+    /// dividing the step's problem between the ranks (bands, share, exchange pattern), the
+    /// sweeps' exchanges and sums over the ranks (waits included) and the gather of the
+    /// result. 0 on one rank.
+    double time_exchange = 0;
   };
 
 

@@ -94,6 +94,10 @@ class Ranks(TempDirTestCase):
         self.assertEqual(two["steps"], 8000)
         for name in ("mu", "sigma_xy", "solid_fraction", "power_balance_ratio"):
             self.assert_within_errors(one, two, name)
+        # The split's own cost is timed as a part of the solve's, and only where there is a split.
+        self.assertEqual(one["timing"]["exchange_mean_s"], 0)
+        self.assertGreater(two["timing"]["exchange_mean_s"], 0)
+        self.assertLess(two["timing"]["exchange_mean_s"], two["timing"]["solver_mean_s"])
 
     def test_a_checkpoint_on_two_ranks_resumes_on_one_and_on_three(self):
         args = ["run", "case.prm", "--output", "two", "--quiet", "--set", "Output/Checkpoint step interval=1000"]
