@@ -133,7 +133,7 @@ namespace tribo::app
                                "ranks (docs/scaling.md): run it without mpirun");
             mj->use_solver(std::make_unique<dem::parallel::SolveAcrossRanks>(solver, system, p.ranks));
             log("the contact solve of each step split over " + std::to_string(ranks) +
-                " MPI ranks (horizontal bands, APGS's sweeps on each); every rank detects and "
+                " MPI ranks (horizontal bands, the method's sweeps on each); every rank detects and "
                 "updates the whole system, rank 0 writes (docs/scaling.md)");
           }
         world.integrator = mj.get();

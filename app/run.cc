@@ -151,10 +151,17 @@ namespace tribo::app
     if (ranks > 1 && !scene.build_option.empty())
       throw InputError(o.case_file + ": Simulation/Scene = " + p.scene + " runs in one process; only the disc "
                        "scenes split their contact solve over MPI ranks (docs/scaling.md): run it without mpirun");
-    if (ranks > 1 && p.solver.method != dem::SolverParameters::Method::apgs)
+    using Method = dem::SolverParameters::Method;
+    if (ranks > 1 && p.solver.method != Method::apgs && p.solver.method != Method::nlgs)
       throw InputError(o.case_file + ": " + p.solver.section.entry("Method") + " = " + dem::method_name(p.solver.method) +
-                       ": on " + std::to_string(ranks) + " MPI ranks the contact solve is APGS's sweeps split into "
-                       "bands (docs/scaling.md); set it to apgs, or run the case without mpirun");
+                       ": on " + std::to_string(ranks) + " MPI ranks the contact solve is APGS's or NLGS's sweeps "
+                       "split into bands (docs/scaling.md); set it to apgs or nlgs, or run the case without mpirun");
+    if (ranks > 1 && p.solver.method == Method::nlgs &&
+        (p.solver.order != dem::SolverParameters::Order::fixed || p.solver.streams > 1))
+      throw InputError(o.case_file + ": " + p.solver.section.entry("Contact order") + " and " +
+                       p.solver.section.entry("Streams") + ": on " + std::to_string(ranks) +
+                       " MPI ranks NLGS sweeps each rank's contacts in detection order (docs/scaling.md); "
+                       "set them to fixed and 1, or run the case without mpirun");
     if (ranks > 1 && !coupling::is_wall_of_discs(file.get("Shear cell/Upper body model")))
       throw InputError(o.case_file + ": Shear cell/Upper body model = " + file.get("Shear cell/Upper body model") +
                        ": a deformable first body is not split over MPI ranks (docs/scaling.md); run the case "

@@ -12,7 +12,9 @@
 /// order, bit for bit.
 ///
 /// The stopping test is the law residual (dem/laws/law_residual.h) over all ranks' contacts,
-/// max |phi| over the mean loaded impulse: two reductions every check_interval sweeps.
+/// max |phi| over the mean loaded impulse: two reductions every check_interval sweeps; or, with
+/// DistributedControls::nlgs_stop (Solver/Method = nlgs on N ranks), NLGS's own test, the
+/// established code's norms over all ranks' contacts (NlgsCheckSums, dem/solvers/nlgs.h).
 ///
 /// Without friction the sweeps carry Nesterov's momentum, as APGS's do: y_k+1 = S(z_k),
 /// t_k+1 = (1 + sqrt(1 + 4 t_k^2)) / 2, z_k+1 = y_k+1 + (t_k - 1) / t_k+1 (y_k+1 - y_k), with the

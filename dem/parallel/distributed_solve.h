@@ -5,6 +5,7 @@
 
 #include "dem/laws/contact_law.h"
 #include "dem/parallel/rank_problem.h"
+#include "dem/solvers/contact_solver.h"
 
 #include <mpi.h>
 
@@ -38,12 +39,25 @@ namespace tribo::dem::parallel
     bool                          polish          = true;
     static constexpr unsigned int polish_patience = 8;
     static constexpr unsigned int max_polishes    = 256;
+    /// DistributedGaussSeidel without momentum: stop as NLGS does (dem/solvers/nlgs.h), by the
+    /// established code's norm @p nlgs_norm at Tolerance nlgs_tolerance over every rank's
+    /// contacts (one check pass, then two reductions), and the gap violation at most
+    /// nlgs_gap_tolerance (m; 0: not checked); residual_target is then unused. Every contact is
+    /// relaxed by nlgs_relaxation (NLGS's Relaxation). False: the law residual stops it.
+    bool                   nlgs_stop          = false;
+    SolverParameters::Norm nlgs_norm          = SolverParameters::Norm::quad;
+    double                 nlgs_tolerance     = 1e-4;
+    double                 nlgs_gap_tolerance = 0;
+    double                 nlgs_relaxation    = 1;
   };
 
   /// What a distributed solve achieved; the same on every rank.
   struct DistributedReport
   {
     unsigned int sweeps        = 0;
+    /// With DistributedControls::nlgs_stop: NLGS's criterion times its tolerance at the last
+    /// check (SolveReport::residual).
+    double       nlgs_residual = 0;
     unsigned int checks        = 0;
     double       law_residual  = 0; ///< over every rank's contacts at the last check
     double       gap_violation = 0; ///< theta h max(0, -(u_n + b)) over every IQS contact, m

@@ -2,6 +2,7 @@
 
 #include "dem/parallel/all_gather.h"
 #include "dem/parallel/distributed_apgs.h"
+#include "dem/parallel/distributed_gauss_seidel.h"
 #include "dem/parallel/rank_problem.h"
 
 #include <deal.II/base/mpi.h>
@@ -32,9 +33,7 @@ namespace tribo::dem::parallel
     , system(system)
     , comm(comm)
   {
-    SolverParameters apgs = p;
-    apgs.method           = SolverParameters::Method::apgs;
-    whole                 = make_contact_solver(apgs);
+    whole = make_contact_solver(p);
   }
 
   SolveAcrossRanks::~SolveAcrossRanks() = default;
@@ -53,12 +52,27 @@ namespace tribo::dem::parallel
     const std::vector<double> heights = contact_heights(system, contacts);
     RankProblem problem = share_of(system, contacts, heights, state, BandPartition::balanced(heights, ranks),
                                    dealii::Utilities::MPI::this_mpi_process(comm));
-    DistributedApgs apgs(problem, comm);
-    const double    divide = since(start);
+    const bool                       nlgs = prm.method == SolverParameters::Method::nlgs;
+    std::unique_ptr<DistributedSolver> sweeps;
+    if (nlgs)
+      sweeps = std::make_unique<DistributedGaussSeidel>(problem, comm);
+    else
+      sweeps = std::make_unique<DistributedApgs>(problem, comm);
+    const double        divide = since(start);
     DistributedControls controls;
-    controls.residual_target     = prm.residual_target;
-    controls.max_sweeps          = prm.max_iterations;
-    const DistributedReport done = apgs.solve(problem, law, controls, theta_h);
+    controls.residual_target = prm.residual_target;
+    controls.max_sweeps      = prm.max_iterations;
+    if (nlgs)
+      {
+        controls.momentum           = false;
+        controls.nlgs_stop          = true;
+        controls.check_interval     = prm.check_interval;
+        controls.nlgs_norm          = prm.norm;
+        controls.nlgs_tolerance     = prm.tolerance;
+        controls.nlgs_gap_tolerance = prm.gap_tolerance;
+        controls.nlgs_relaxation    = prm.relaxation;
+      }
+    const DistributedReport done = sweeps->solve(problem, law, controls, theta_h);
     start                        = std::chrono::steady_clock::now();
 
     // Each owned contact's impulse and each owned grain's velocity, to every rank.
@@ -89,8 +103,9 @@ namespace tribo::dem::parallel
     report.time_exchange = divide + done.time_communication + since(start);
     report.iterations    = done.sweeps;
     report.check_passes  = done.checks;
-    report.law_residual  = done.law_residual;
-    report.residual      = done.law_residual;
+    report.law_residual   = done.law_residual;
+    report.residual       = nlgs ? done.nlgs_residual : done.law_residual;
+    report.solved_by_nlgs = nlgs;
     report.gap_violation = done.gap_violation;
     report.converged     = done.converged;
     report.concurrent    = true;

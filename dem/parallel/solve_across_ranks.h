@@ -2,8 +2,9 @@
 /// @file The contact solver of a case run on several MPI ranks (`mpirun -np N tribo run`):
 /// every rank holds the whole particle system and detects and updates it whole; the
 /// contact solve of each step is split into horizontal bands, one per rank, and solved by
-/// DistributedApgs (dem/parallel/distributed_apgs.h); its result is then gathered, so
-/// that every rank goes on with the same impulses and velocities.
+/// DistributedApgs (dem/parallel/distributed_apgs.h) or, for Solver/Method = nlgs, by
+/// DistributedGaussSeidel's plain sweeps stopped by NLGS's own test; its result is then
+/// gathered, so that every rank goes on with the same impulses and velocities.
 
 #include "dem/engine/particle_system.h"
 #include "dem/solvers/contact_solver.h"
@@ -16,13 +17,15 @@ namespace tribo::dem::parallel
   /// - bands of equal contact counts over the step's contacts (contact_bands), this rank's
   ///   share of them (share_of) and DistributedApgs's sweeps, stopped at
   ///   SolverParameters::residual_target of the law residual over all ranks, or after
-  ///   max_iterations sweeps;
+  ///   max_iterations sweeps (with Method = nlgs: Gauss-Seidel sweeps inside each rank,
+  ///   relaxed by Relaxation, stopped by the established code's Norm at Tolerance over all
+  ///   ranks and by the Gap tolerance, checked every Check interval sweeps);
   /// - then every contact's impulse r (from its owner) and every grain's velocity (from its
   ///   owner) gathered on every rank (MPI_Allgatherv), and the walls' velocities taken from
   ///   rank 0, so that the ranks' states stay identical bit for bit: each then detects the
   ///   same contacts in the next step.
   /// With fewer than min_contacts_per_rank contacts per rank the step is solved whole by
-  /// APGS on every rank (the same bits everywhere).
+  /// the method (APGS or NLGS) on every rank (the same bits everywhere).
   ///
   /// Needs every contact between discs (no deal.II first body: share_of refuses half-discs).
   /// Memory and the detection and update are not divided by the ranks (docs/scaling.md).
@@ -45,6 +48,6 @@ namespace tribo::dem::parallel
   private:
     const ParticleSystem          &system;
     MPI_Comm                       comm;
-    std::unique_ptr<ContactSolver> whole; ///< APGS, for the steps with few contacts
+    std::unique_ptr<ContactSolver> whole; ///< the method whole, for the steps with few contacts
   };
 } // namespace tribo::dem::parallel

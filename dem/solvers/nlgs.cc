@@ -78,62 +78,55 @@ namespace tribo::dem
                                    " (" + f.where(entry(name)) + ")";
   }
 
-  namespace
+  void NlgsCheckSums::add(const Eigen::Matrix2d &W, const Eigen::Vector2d &r_old, const Eigen::Vector2d &r_new)
   {
-    /// The established code's convergence sums over one pass (docs/laws.md,
-    /// "Convergence norms"), fed with each contact's impulse before and after its local
-    /// solve.
-    struct CheckSums
-    {
-      double       wrwr = 0, wrr = 0, dvdv = 0, dvdvrr = 0, dvor = 0;
-      double       max_dvdv = 0, max_dvdvrr = 0;
-      unsigned int active = 0; ///< contacts with a non-zero mean impulse
+    const Eigen::Vector2d r_bar = 0.5 * (r_old + r_new);
+    if (r_bar.x() == 0 && r_bar.y() == 0)
+      return;
+    ++active;
+    const Eigen::Vector2d dv     = W * (r_new - r_old);
+    const Eigen::Vector2d wr_old = W * r_old, wr_new = W * r_new;
+    const double          d2     = dv.squaredNorm();
+    wrwr += 0.5 * (wr_old.squaredNorm() + wr_new.squaredNorm());
+    wrr += 0.5 * (wr_old.dot(r_old) + wr_new.dot(r_new));
+    dvdv += d2;
+    dvdvrr += d2 * r_bar.squaredNorm();
+    dvor += r_bar.dot(dv);
+    max_dvdv   = std::max(max_dvdv, d2);
+    max_dvdvrr = std::max(max_dvdvrr, d2 * r_bar.squaredNorm());
+  }
 
-      void add(const Eigen::Matrix2d &W, const Eigen::Vector2d &r_old, const Eigen::Vector2d &r_new)
-      {
-        const Eigen::Vector2d r_bar = 0.5 * (r_old + r_new);
-        if (r_bar.x() == 0 && r_bar.y() == 0)
-          return;
-        ++active;
-        const Eigen::Vector2d dv     = W * (r_new - r_old);
-        const Eigen::Vector2d wr_old = W * r_old, wr_new = W * r_new;
-        const double          d2     = dv.squaredNorm();
-        wrwr += 0.5 * (wr_old.squaredNorm() + wr_new.squaredNorm());
-        wrr += 0.5 * (wr_old.dot(r_old) + wr_new.dot(r_new));
-        dvdv += d2;
-        dvdvrr += d2 * r_bar.squaredNorm();
-        dvor += r_bar.dot(dv);
-        max_dvdv   = std::max(max_dvdv, d2);
-        max_dvdvrr = std::max(max_dvdvrr, d2 * r_bar.squaredNorm());
-      }
+  void NlgsCheckSums::merge(const NlgsCheckSums &o)
+  {
+    wrwr += o.wrwr;
+    wrr += o.wrr;
+    dvdv += o.dvdv;
+    dvdvrr += o.dvdvrr;
+    dvor += o.dvor;
+    max_dvdv   = std::max(max_dvdv, o.max_dvdv);
+    max_dvdvrr = std::max(max_dvdvrr, o.max_dvdvrr);
+    active += o.active;
+  }
 
-      void merge(const CheckSums &o)
-      {
-        wrwr += o.wrwr;
-        wrr += o.wrr;
-        dvdv += o.dvdv;
-        dvdvrr += o.dvdvrr;
-        dvor += o.dvor;
-        max_dvdv   = std::max(max_dvdv, o.max_dvdv);
-        max_dvdvrr = std::max(max_dvdvrr, o.max_dvdvrr);
-        active += o.active;
-      }
+  double NlgsCheckSums::criterion(SolverParameters::Norm norm, double tol) const
+  {
+    const double N         = active;
+    const double quad_wr   = std::sqrt(wrwr / N);
+    const double mean_wrr  = wrr / N;
+    const double mean_dvor = wrr > 0 ? dvor / (wrr * tol) : 0;
+    const bool   quad      = norm == SolverParameters::Norm::quad;
+    const double dv_norm   = quad_wr > 0 ? std::sqrt(quad ? dvdv / N : max_dvdv) / (quad_wr * tol) : 0;
+    const double dvr_norm  = mean_wrr > 0 ? std::sqrt(quad ? dvdvrr / N : max_dvdvrr) / (mean_wrr * tol) : 0;
+    return std::max({std::abs(mean_dvor), dv_norm, dvr_norm});
+  }
 
-      /// max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm ones), relative to @p tol.
-      double criterion(SolverParameters::Norm norm, double tol) const
-      {
-        const double N         = active;
-        const double quad_wr   = std::sqrt(wrwr / N);
-        const double mean_wrr  = wrr / N;
-        const double mean_dvor = wrr > 0 ? dvor / (wrr * tol) : 0;
-        const bool   quad      = norm == SolverParameters::Norm::quad;
-        const double dv_norm   = quad_wr > 0 ? std::sqrt(quad ? dvdv / N : max_dvdv) / (quad_wr * tol) : 0;
-        const double dvr_norm =
-          mean_wrr > 0 ? std::sqrt(quad ? dvdvrr / N : max_dvdvrr) / (mean_wrr * tol) : 0;
-        return std::max({std::abs(mean_dvor), dv_norm, dvr_norm});
-      }
-    };
-  } // namespace
+  double NlgsCheckSums::check(const Contact &c, const BodyState &state, const ContactLaw &law)
+  {
+    const Eigen::Vector2d   u_now = state.local_velocity(c);
+    const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
+    add(c.W, c.r, law.solve(c.W, u_now - c.W * c.r, terms));
+    return -(u_now.x() + c.shift);
+  }
 
   namespace
   {
@@ -214,20 +207,16 @@ namespace tribo::dem
     // The check pass over band k: every contact's local solve against the state the
     // sweeps left, nothing applied (as the established code does: a sweep's own changes
     // would measure where the sweep went, not how far the state is from the solution).
-    std::vector<CheckSums> band_sums(n_bands);
+    std::vector<NlgsCheckSums> band_sums(n_bands);
     std::vector<double>    band_violation(n_bands);
     auto check_band = [&](unsigned int k) {
-      CheckSums sums;
-      double    violation = 0;
+      NlgsCheckSums sums;
+      double        violation = 0;
       for (unsigned int i = begin[k]; i < begin[k + 1]; ++i)
         {
-          const Contact          &c     = contacts[order[i]];
-          const Eigen::Vector2d   u_now = state.local_velocity(c);
-          const ContactLaw::Terms terms{c.cohesion_impulse, c.shift, c.compliance};
-          const Eigen::Vector2d   r_law = law.solve(c.W, u_now - c.W * c.r, terms);
+          const double closing = sums.check(contacts[order[i]], state, law);
           if (iqs)
-            violation = std::max(violation, -(u_now.x() + c.shift));
-          sums.add(c.W, c.r, r_law);
+            violation = std::max(violation, closing);
         }
       band_sums[k]      = sums;
       band_violation[k] = violation;
@@ -265,8 +254,8 @@ namespace tribo::dem
           continue;
         ++report.check_passes;
         over_bands(0, 1, check_band);
-        CheckSums sums;
-        double    max_violation = 0;
+        NlgsCheckSums sums;
+        double        max_violation = 0;
         for (unsigned int k = 0; k < n_bands; ++k)
           {
             sums.merge(band_sums[k]);

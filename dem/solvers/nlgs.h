@@ -44,6 +44,25 @@ namespace tribo::dem
     c.r = r_new;
   }
 
+  /// The established code's convergence sums over one check pass (the file comment's norms),
+  /// fed with each contact's impulse before and after its local solve; merged over the bands
+  /// of a sweep, or summed over MPI ranks (dem/parallel/distributed_gauss_seidel.h).
+  struct NlgsCheckSums
+  {
+    double       wrwr = 0, wrr = 0, dvdv = 0, dvdvrr = 0, dvor = 0;
+    double       max_dvdv = 0, max_dvdvrr = 0;
+    unsigned int active = 0; ///< contacts with a non-zero mean impulse
+
+    void add(const Eigen::Matrix2d &W, const Eigen::Vector2d &r_old, const Eigen::Vector2d &r_new);
+    /// Contact @p c's check: its local solve against @p state, nothing applied, added; returns
+    /// its closing rate -(u_n + b) (m/s; the gap violation's, for IQS).
+    double check(const Contact &c, const BodyState &state, const ContactLaw &law);
+    void   merge(const NlgsCheckSums &o);
+    /// max(|MeanDVoR|, QuadDV, QuadDVR) (or the Maxm ones), relative to @p tol: below 1 is
+    /// converged.
+    double criterion(SolverParameters::Norm norm, double tol) const;
+  };
+
   /// The solver; it keeps its random generator across steps (reproducible from the seed).
   class NlgsSolver : public ContactSolver
   {

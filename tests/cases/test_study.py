@@ -125,8 +125,8 @@ class Study(WithBaseCase):
         # 50 discs: under 64 contacts per rank a step is solved whole on every rank, the serial bits.
         self.assertEqual(table(os.path.join(self.dir, "serial")), table(os.path.join(self.dir, "four")))
         # A study whose cases cannot be split runs one case per rank.
-        self.write_study("; Solver/Method = nlgs")
-        log = self.study("nlgs", mpi_ranks=4)
+        self.write_study("; Solver/Method = interior-point")
+        log = self.study("ip", mpi_ranks=4)
         self.assertNotIn("each case on", log)
         self.assertIn("case 1 (rank 1): running", log)
 

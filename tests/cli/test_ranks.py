@@ -6,8 +6,10 @@
 - a checkpoint written on two ranks (stopped by SIGTERM) resumes on one rank (to the end)
   and on three (300 steps): the rows before the checkpoint are kept bit for bit and both
   complete within the residual target;
+- NLGS on two ranks stops by its own norm (Quad 1e-4 over both ranks' contacts) at about the
+  serial sweeps;
 - what is not split over ranks is refused with the cause and the remedy, before anything is
-  written: another solver method, a deformable first body.
+  written: another solver method, NLGS in another order, a deformable first body.
 
 Usage: /usr/bin/python3 test_ranks.py /path/to/tribo
 """
@@ -137,21 +139,49 @@ class Ranks(TempDirTestCase):
             self.assertEqual(int(float(rows[-1][1])), steps)
             self.assertFalse(os.path.exists(os.path.join(self.tmp, out, "checkpoint.bin")))
 
-    def test_what_is_not_split_is_refused_with_the_remedy(self):
-        r = self.run_ranks(2, ["run", "case.prm", "--output", "nlgs", "--set", "Solver/Method=nlgs"])
-        self.assertEqual(r.returncode, 2)
-        self.assertEqual(r.stderr.strip().splitlines().count(
-            "error: case.prm: Solver/Method = nlgs: on 2 MPI ranks the contact solve is APGS's sweeps split into "
-            "bands (docs/scaling.md); set it to apgs, or run the case without mpirun"), 1, r.stderr)
-        self.assertFalse(os.path.exists(os.path.join(self.tmp, "nlgs")), "nothing is written")
+    def test_nlgs_on_two_ranks_stops_by_its_own_norm(self):
+        # 1000 steps of the compaction: NLGS (Quad 1e-4) on two ranks against one.
+        args = ["--quiet", "--set", "Solver/Method=nlgs", "--set", "Simulation/End time=2e-6"]
+        r = run(["run", "case.prm", "--output", "one"] + args, self.tmp, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = self.run_ranks(2, ["run", "case.prm", "--output", "two"] + args)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        one, two = (read_json(os.path.join(self.tmp, out, "summary.json")) for out in ("one", "two"))
+        self.assertEqual((two["status"], two["steps"], two["solver_method"]), ("complete", 1000, "nlgs"))
+        rows = statistics(os.path.join(self.tmp, "two"))
+        column = {name: k for k, name in enumerate(rows[0])}
+        converged = [row for row in rows[1:] if row[column["solver_converged"]] == "1"]
+        self.assertGreater(len(converged), 0.9 * (len(rows) - 1))
+        for row in converged:  # NLGS's criterion times its tolerance, at most the tolerance
+            self.assertLessEqual(float(row[column["solver_residual"]]), 1e-4)
+        # The coupling across the two bands costs a few sweeps, not many.
+        self.assertLess(two["solver_iterations_mean"], 1.25 * one["solver_iterations_mean"])
+        # The same compaction: the layer's solid fraction at its end.
+        last = [float(statistics(os.path.join(self.tmp, out))[-1][column["solid_fraction"]]) for out in ("one", "two")]
+        self.assertLess(abs(last[1] - last[0]), 0.01, last)
 
-        r = self.run_ranks(2, ["run", "case.prm", "--output", "fem", "--set", "Shear cell/Upper body model=fem"])
+    def assert_refused(self, out, entries, message):
+        """On two ranks, the case with @p entries set stops with @p message once and writes nothing."""
+        args = ["run", "case.prm", "--output", out]
+        for entry in entries:
+            args += ["--set", entry]
+        r = self.run_ranks(2, args)
         self.assertEqual(r.returncode, 2, r.stderr)
-        self.assertEqual(r.stderr.strip().splitlines().count(
-            "error: case.prm: Shear cell/Upper body model = fem: a deformable first body is not split over MPI "
-            "ranks (docs/scaling.md); run the case without mpirun"), 1, r.stderr)
-        self.assertFalse(os.path.exists(os.path.join(self.tmp, "fem")), "nothing is written")
+        self.assertEqual(r.stderr.strip().splitlines().count("error: case.prm: " + message), 1, r.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, out)), "nothing is written")
 
+    def test_what_is_not_split_is_refused_with_the_remedy(self):
+        self.assert_refused("ip", ["Solver/Method=interior-point"],
+                            "Solver/Method = interior-point: on 2 MPI ranks the contact solve is APGS's or NLGS's "
+                            "sweeps split into bands (docs/scaling.md); set it to apgs or nlgs, or run the case "
+                            "without mpirun")
+        self.assert_refused("order", ["Solver/Method=nlgs", "Solver/Contact order=random"],
+                            "Solver/Contact order and Solver/Streams: on 2 MPI ranks NLGS sweeps each rank's "
+                            "contacts in detection order (docs/scaling.md); set them to fixed and 1, or run the "
+                            "case without mpirun")
+        self.assert_refused("fem", ["Shear cell/Upper body model=fem"],
+                            "Shear cell/Upper body model = fem: a deformable first body is not split over MPI "
+                            "ranks (docs/scaling.md); run the case without mpirun")
 
 if __name__ == "__main__":
     tribo_cli.main()

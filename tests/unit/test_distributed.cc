@@ -319,3 +319,60 @@ int main(int argc, char **argv)
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
 }
+
+TEST(Distributed, NlgsStopsAsTheSerialNlgsAndGivesItsAnswerOnEveryRankCount)
+{
+  // Solver/Method = nlgs on N ranks: plain sweeps stopped by the established code's norm over
+  // every rank's contacts. On one rank it is the serial NLGS, bit for bit, at its check and
+  // stop; on more, its tight answer is the serial one.
+  const ColdStart cold;
+  const auto      solve_on = [&](MPI_Comm comm, double tolerance, std::vector<Eigen::Vector3d> &velocity) {
+    const unsigned int n = dealii::Utilities::MPI::n_mpi_processes(comm);
+    RankProblem        p = share_of(cold.system, cold.contacts, BodyState::of(cold.system),
+                                    contact_bands(cold.system, cold.contacts, n),
+                                    dealii::Utilities::MPI::this_mpi_process(comm));
+    DistributedControls controls;
+    controls.momentum       = false;
+    controls.nlgs_stop      = true;
+    controls.nlgs_tolerance = tolerance;
+    controls.max_sweeps     = 100000;
+    const DistributedReport report = DistributedGaussSeidel(p, comm).solve(p, cold.law, controls);
+    if (comm == world())
+      velocity = gathered_velocities(p, cold.system.bodies.size());
+    return std::make_pair(report, p);
+  };
+  for (const double tolerance : {1e-4, 1e-10})
+    {
+      SolverParameters prm;
+      prm.method              = SolverParameters::Method::nlgs;
+      prm.tolerance           = tolerance;
+      prm.max_iterations      = 100000;
+      std::vector<Contact> serial = cold.contacts;
+      BodyState            state  = BodyState::of(cold.system);
+      const SolveReport    nlgs   = NlgsSolver(prm).solve(serial, state, cold.law);
+      ASSERT_TRUE(nlgs.converged);
+
+      std::vector<Eigen::Vector3d> unused, velocity;
+      const auto [alone, p] = solve_on(MPI_COMM_SELF, tolerance, unused);
+      EXPECT_TRUE(alone.converged);
+      EXPECT_EQ(alone.sweeps, nlgs.iterations);
+      EXPECT_EQ(alone.nlgs_residual, nlgs.residual);
+      for (std::size_t i = 0; i < p.contacts.size(); ++i)
+        EXPECT_EQ(p.contacts[i].r, serial[p.serial_contact[i]].r) << "contact " << i;
+
+      const auto [here, mine] = solve_on(world(), tolerance, velocity);
+      EXPECT_TRUE(here.converged);
+      EXPECT_LT(here.nlgs_residual, tolerance);
+      // The coupling across ranks costs a few sweeps (docs/scaling.md).
+      EXPECT_LE(here.sweeps, nlgs.iterations + nlgs.iterations / 2);
+      if (tolerance < 1e-8)
+        {
+          double worst = 0;
+          for (std::size_t b = 0; b < velocity.size(); ++b)
+            worst = std::max(worst, (velocity[b] - state.velocity[b]).head<2>().lpNorm<Eigen::Infinity>());
+          EXPECT_LT(worst, 1e-6) << n_ranks() << " ranks";
+        }
+      std::cout << "[ measure  ] NLGS's test, " << n_ranks() << " ranks, tolerance " << tolerance << ": " << here.sweeps
+                << " sweeps (serial NLGS " << nlgs.iterations << ")" << std::endl;
+    }
+}
