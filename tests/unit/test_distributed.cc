@@ -208,31 +208,40 @@ namespace
   /// The loaded upper wall, which lands on the layer: the last body of tall_layer().
   unsigned int upper_wall(const ColdStart &cold) { return static_cast<unsigned int>(cold.system.bodies.size()) - 1; }
 
-  /// The two distributed solves: Gauss-Seidel in velocity form, APGS's sweeps in operator form.
+  /// The distributed solves: Gauss-Seidel in velocity form, APGS's sweeps in operator form, and
+  /// the plain Gauss-Seidel sweeps stopped by NLGS's test (Solver/Method = nlgs on N ranks).
   enum class Sweeps
   {
     gauss_seidel,
-    apgs
+    apgs,
+    nlgs
   };
 
   /// Solve @p cold's problem on @p comm's ranks (MPI_COMM_SELF: the serial solve) to
-  /// @p target; the report, and the gathered velocities and upper wall's impulse.
+  /// @p target (with Sweeps::nlgs: NLGS's Tolerance, Quad); the report, this rank's problem,
+  /// and the gathered velocities and upper wall's impulse.
   struct Distributed
   {
     DistributedReport            report;
+    RankProblem                  p;
     std::vector<Eigen::Vector3d> velocity;
     Eigen::Vector2d              wall_impulse;
     Distributed(const ColdStart &cold, double target, MPI_Comm comm, bool momentum = true,
                 Sweeps sweeps = Sweeps::gauss_seidel)
+      : p(share_of(cold.system, cold.contacts, BodyState::of(cold.system),
+                   contact_bands(cold.system, cold.contacts, dealii::Utilities::MPI::n_mpi_processes(comm)),
+                   dealii::Utilities::MPI::this_mpi_process(comm)))
     {
-      const unsigned int n = dealii::Utilities::MPI::n_mpi_processes(comm);
-      RankProblem        p = share_of(cold.system, cold.contacts, BodyState::of(cold.system),
-                                      contact_bands(cold.system, cold.contacts, n),
-                                      dealii::Utilities::MPI::this_mpi_process(comm));
       DistributedControls controls;
       controls.residual_target = target;
       controls.max_sweeps      = 100000;
       controls.momentum        = momentum;
+      if (sweeps == Sweeps::nlgs)
+        {
+          controls.momentum       = false;
+          controls.nlgs_stop      = true;
+          controls.nlgs_tolerance = target;
+        }
       report       = sweeps == Sweeps::apgs ? DistributedApgs(p, comm).solve(p, cold.law, controls)
                                                 : DistributedGaussSeidel(p, comm).solve(p, cold.law, controls);
       wall_impulse = impulse_on(p.contacts, p.serial_body, upper_wall(cold), true);
@@ -313,34 +322,12 @@ TEST(Distributed, ApgsSweepsWithCoulombFrictionGiveTheSerialAnswer)
   expect_serial_answer(ColdStart(law), 1e-9, 1e-6, 1e-6, Sweeps::apgs);
 }
 
-int main(int argc, char **argv)
-{
-  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-  ::testing::InitGoogleTest(&argc, argv);
-  return RUN_ALL_TESTS();
-}
-
 TEST(Distributed, NlgsStopsAsTheSerialNlgsAndGivesItsAnswerOnEveryRankCount)
 {
   // Solver/Method = nlgs on N ranks: plain sweeps stopped by the established code's norm over
   // every rank's contacts. On one rank it is the serial NLGS, bit for bit, at its check and
   // stop; on more, its tight answer is the serial one.
   const ColdStart cold;
-  const auto      solve_on = [&](MPI_Comm comm, double tolerance, std::vector<Eigen::Vector3d> &velocity) {
-    const unsigned int n = dealii::Utilities::MPI::n_mpi_processes(comm);
-    RankProblem        p = share_of(cold.system, cold.contacts, BodyState::of(cold.system),
-                                    contact_bands(cold.system, cold.contacts, n),
-                                    dealii::Utilities::MPI::this_mpi_process(comm));
-    DistributedControls controls;
-    controls.momentum       = false;
-    controls.nlgs_stop      = true;
-    controls.nlgs_tolerance = tolerance;
-    controls.max_sweeps     = 100000;
-    const DistributedReport report = DistributedGaussSeidel(p, comm).solve(p, cold.law, controls);
-    if (comm == world())
-      velocity = gathered_velocities(p, cold.system.bodies.size());
-    return std::make_pair(report, p);
-  };
   for (const double tolerance : {1e-4, 1e-10})
     {
       SolverParameters prm;
@@ -352,27 +339,33 @@ TEST(Distributed, NlgsStopsAsTheSerialNlgsAndGivesItsAnswerOnEveryRankCount)
       const SolveReport    nlgs   = NlgsSolver(prm).solve(serial, state, cold.law);
       ASSERT_TRUE(nlgs.converged);
 
-      std::vector<Eigen::Vector3d> unused, velocity;
-      const auto [alone, p] = solve_on(MPI_COMM_SELF, tolerance, unused);
-      EXPECT_TRUE(alone.converged);
-      EXPECT_EQ(alone.sweeps, nlgs.iterations);
-      EXPECT_EQ(alone.nlgs_residual, nlgs.residual);
-      for (std::size_t i = 0; i < p.contacts.size(); ++i)
-        EXPECT_EQ(p.contacts[i].r, serial[p.serial_contact[i]].r) << "contact " << i;
+      const Distributed alone(cold, tolerance, MPI_COMM_SELF, false, Sweeps::nlgs);
+      EXPECT_TRUE(alone.report.converged);
+      EXPECT_EQ(alone.report.sweeps, nlgs.iterations);
+      EXPECT_EQ(alone.report.nlgs_residual, nlgs.residual);
+      for (std::size_t i = 0; i < alone.p.contacts.size(); ++i)
+        EXPECT_EQ(alone.p.contacts[i].r, serial[alone.p.serial_contact[i]].r) << "contact " << i;
 
-      const auto [here, mine] = solve_on(world(), tolerance, velocity);
-      EXPECT_TRUE(here.converged);
-      EXPECT_LT(here.nlgs_residual, tolerance);
+      const Distributed here(cold, tolerance, world(), false, Sweeps::nlgs);
+      EXPECT_TRUE(here.report.converged);
+      EXPECT_LT(here.report.nlgs_residual, tolerance);
       // The coupling across ranks costs a few sweeps (docs/scaling.md).
-      EXPECT_LE(here.sweeps, nlgs.iterations + nlgs.iterations / 2);
+      EXPECT_LE(here.report.sweeps, nlgs.iterations + nlgs.iterations / 2);
       if (tolerance < 1e-8)
         {
           double worst = 0;
-          for (std::size_t b = 0; b < velocity.size(); ++b)
-            worst = std::max(worst, (velocity[b] - state.velocity[b]).head<2>().lpNorm<Eigen::Infinity>());
+          for (std::size_t b = 0; b < here.velocity.size(); ++b)
+            worst = std::max(worst, (here.velocity[b] - state.velocity[b]).head<2>().lpNorm<Eigen::Infinity>());
           EXPECT_LT(worst, 1e-6) << n_ranks() << " ranks";
         }
-      std::cout << "[ measure  ] NLGS's test, " << n_ranks() << " ranks, tolerance " << tolerance << ": " << here.sweeps
-                << " sweeps (serial NLGS " << nlgs.iterations << ")" << std::endl;
+      std::cout << "[ measure  ] NLGS's test, " << n_ranks() << " ranks, tolerance " << tolerance << ": "
+                << here.report.sweeps << " sweeps (serial NLGS " << nlgs.iterations << ")" << std::endl;
     }
+}
+
+int main(int argc, char **argv)
+{
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
 }
