@@ -128,13 +128,11 @@ namespace tribo::app
         scene->attach(*mj);
         if (const unsigned int ranks = rank_count(p.ranks); ranks > 1)
           {
-            if (mj->n_boundary_bodies() > 0)
-              throw InputError("this case has a deformable first body, which is not split over MPI "
-                               "ranks (docs/scaling.md): run it without mpirun");
             mj->use_solver(std::make_unique<dem::parallel::SolveAcrossRanks>(solver, system, p.ranks));
             log("the contact solve of each step split over " + std::to_string(ranks) +
-                " MPI ranks (horizontal bands, the method's sweeps on each); every rank detects and "
-                "updates the whole system, rank 0 writes (docs/scaling.md)");
+                " MPI ranks (horizontal bands, the method's sweeps on each; a deformable first body's "
+                "contacts on the top band's rank); every rank detects and updates the whole system, "
+                "first bodies included, rank 0 writes (docs/scaling.md)");
           }
         world.integrator = mj.get();
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));

@@ -139,6 +139,9 @@ namespace tribo::dem::parallel
         }
       others.velocity.assign(n_local, Eigen::Vector3d::Zero());
       others.inverse_mass = p.state.inverse_mass;
+      // A boundary body's nodes change on this rank only (it holds all their contacts).
+      others.node_velocity = Eigen::VectorXd::Zero(p.state.node_velocity.size());
+      others.node_blocks   = p.state.node_blocks;
     }
 
     std::vector<Contact> &RankSweeps::with_local_free_velocities()

@@ -1,7 +1,5 @@
 #include "dem/parallel/rank_problem.h"
 
-#include "core/errors.h"
-
 #include <algorithm>
 
 namespace tribo::dem::parallel
@@ -15,9 +13,12 @@ namespace tribo::dem::parallel
       return disc.offset.x() == 0 && disc.offset.y() == 0 ? system.bodies[disc.body].position.y() : system.disc_centre(d).y();
     }
 
-    /// Height of the midpoint of contact @p c's two disc centres, m.
+    /// Height of the midpoint of contact @p c's two disc centres, m; a half-disc contact's,
+    /// its grain's.
     double contact_height(const ParticleSystem &system, const Contact &c)
     {
+      if (c.on_boundary())
+        return disc_height(system, c.disc[1]);
       return 0.5 * (disc_height(system, c.disc[0]) + disc_height(system, c.disc[1]));
     }
 
@@ -75,18 +76,19 @@ namespace tribo::dem::parallel
       if (grain[b])
         global[b] = count[band[b]]++;
 
-    // Owned contacts, and the grains they touch.
-    std::vector<bool> touched(n_bodies, false);
+    // Owned contacts, and the grains they touch. A half-disc contact belongs to the top
+    // band, whatever its height: a boundary body's contacts are coupled by its compliance,
+    // so one rank holds them all, and its nodes' velocities (side 0; body[0] unused).
+    const unsigned int top = bands.n_bands() - 1;
+    std::vector<bool>  touched(n_bodies, false);
     for (std::size_t i = 0; i < contacts.size(); ++i)
       {
         const Contact &c = contacts[i];
-        if (c.on_boundary())
-          throw RunError("a contact with a half-disc element: a deformable first body is not yet "
-                         "distributed over MPI ranks (dem/parallel/README.md)");
-        if (bands.band_of(heights[i]) != rank)
+        if ((c.on_boundary() ? top : bands.band_of(heights[i])) != rank)
           continue;
         p.serial_contact.push_back(static_cast<unsigned int>(i));
-        touched[c.body[0]] = touched[c.body[1]] = true;
+        for (int s = c.on_boundary() ? 1 : 0; s < 2; ++s)
+          touched[c.body[s]] = true;
       }
     std::vector<unsigned int> owned, ghosts, replicated;
     for (unsigned int b = 0; b < n_bodies; ++b)
@@ -121,8 +123,15 @@ namespace tribo::dem::parallel
     for (std::size_t k = 0; k < p.contacts.size(); ++k)
       {
         Contact &c = p.contacts[k] = contacts[p.serial_contact[k]];
-        c.body[0]  = local[c.body[0]];
         c.body[1]  = local[c.body[1]];
+        // A half-disc contact's unused side 0 names its grain too: a local body, and no
+        // other rank's.
+        c.body[0] = c.on_boundary() ? c.body[1] : local[c.body[0]];
+      }
+    if (rank == top)
+      {
+        p.state.node_velocity = state.node_velocity;
+        p.state.node_blocks   = state.node_blocks;
       }
     return p;
   }

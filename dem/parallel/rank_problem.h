@@ -20,7 +20,9 @@ namespace tribo::dem::parallel
   /// so that each rank owns one contiguous range, as deal.II's partitioner wants. A contact
   /// is owned by the band of the midpoint of its two discs' centres, which is the band of
   /// one of its grains. Clumps (the walls: a few degrees of freedom) are replicated on
-  /// every rank.
+  /// every rank. The half-disc contacts of the deformable first bodies all belong to the
+  /// top band, whose rank alone holds the bodies' node velocities and compliance (the
+  /// contacts couple through it); their unused side 0 names their grain.
   struct RankProblem
   {
     /// The owned contacts in serial (detection) order, their bodies numbered locally.
@@ -38,15 +40,15 @@ namespace tribo::dem::parallel
     unsigned int n_replicated() const { return static_cast<unsigned int>(serial_body.size()) - n_owned - n_ghost; }
   };
 
-  /// The height of each contact's midpoint between its two disc centres, m.
+  /// The height of each contact's midpoint between its two disc centres (a half-disc
+  /// contact's: its grain's centre), m.
   std::vector<double> contact_heights(const ParticleSystem &system, const std::vector<Contact> &contacts);
   /// Bands of equal contact counts for @p n ranks, by the contacts' midpoint heights.
   BandPartition contact_bands(const ParticleSystem &system, const std::vector<Contact> &contacts, unsigned int n);
 
   /// Rank @p rank's share of the serial problem @p contacts on @p state (a BodyState over
   /// @p system's bodies, consistent with the contacts' impulses) under @p bands. Every rank
-  /// calls it with the same serial problem. Throws RunError for a half-disc contact (a
-  /// deformable first body is not yet distributed).
+  /// calls it with the same serial problem.
   RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts, const BodyState &state,
                        const BandPartition &bands, unsigned int rank);
   /// The same, with the contacts' @p heights (contact_heights) already computed.

@@ -5,6 +5,8 @@
 #include "dem/parallel/distributed_gauss_seidel.h"
 #include "dem/parallel/rank_problem.h"
 
+#include "core/errors.h"
+
 #include <deal.II/base/mpi.h>
 
 #include <chrono>
@@ -38,10 +40,29 @@ namespace tribo::dem::parallel
 
   SolveAcrossRanks::~SolveAcrossRanks() = default;
 
+  void SolveAcrossRanks::check_same_nodes(const BodyState &state) const
+  {
+    if (state.node_velocity.size() == 0)
+      return;
+    // FNV-1a over the bytes of the node velocities: the least and the largest over the ranks.
+    std::uint64_t hash  = 1469598103934665603ULL;
+    const auto   *bytes = reinterpret_cast<const unsigned char *>(state.node_velocity.data());
+    for (std::size_t k = 0; k < sizeof(double) * std::size_t(state.node_velocity.size()); ++k)
+      hash = (hash ^ bytes[k]) * 1099511628211ULL;
+    std::uint64_t least = 0, largest = 0;
+    MPI_Allreduce(&hash, &least, 1, MPI_UINT64_T, MPI_MIN, comm);
+    MPI_Allreduce(&hash, &largest, 1, MPI_UINT64_T, MPI_MAX, comm);
+    if (least != largest)
+      throw RunError("the deformable first body's node velocities differ between the MPI ranks at the start of "
+                     "a contact solve: its update did not repeat bit for bit on every rank (docs/scaling.md); run "
+                     "the case without mpirun");
+  }
+
   SolveReport SolveAcrossRanks::solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law,
                                       double theta_h)
   {
     const unsigned int ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+    check_same_nodes(state);
     if (contacts.size() < std::size_t(min_contacts_per_rank) * ranks)
       return whole->solve(contacts, state, law, theta_h);
 
@@ -98,6 +119,14 @@ namespace tribo::dem::parallel
     MPI_Bcast(walls.data(), int(walls.size()), MPI_DOUBLE, 0, comm);
     for (unsigned int l = problem.n_owned + problem.n_ghost, k = 0; l < problem.serial_body.size(); ++l, k += 3)
       state.velocity[problem.serial_body[l]] = {walls[k], walls[k + 1], walls[k + 2]};
+
+    // The boundary bodies' nodes: the top band's rank moved them.
+    if (state.node_velocity.size() > 0)
+      {
+        if (dealii::Utilities::MPI::this_mpi_process(comm) == ranks - 1)
+          state.node_velocity = problem.state.node_velocity;
+        MPI_Bcast(state.node_velocity.data(), int(state.node_velocity.size()), MPI_DOUBLE, int(ranks - 1), comm);
+      }
 
     SolveReport report;
     report.time_exchange = divide + done.time_communication + since(start);

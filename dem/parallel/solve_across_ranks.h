@@ -24,10 +24,13 @@ namespace tribo::dem::parallel
   ///   owner) gathered on every rank (MPI_Allgatherv), and the walls' velocities taken from
   ///   rank 0, so that the ranks' states stay identical bit for bit: each then detects the
   ///   same contacts in the next step.
+  ///   With deformable first bodies (half-disc contacts, all solved by the top band's rank),
+  ///   their nodes' velocities come from that rank. Every rank updates such a body itself,
+  ///   so a step starts by checking that the ranks' node velocities agree bit for bit
+  ///   (RunError naming the step's cause otherwise).
   /// With fewer than min_contacts_per_rank contacts per rank the step is solved whole by
   /// the method (APGS or NLGS) on every rank (the same bits everywhere).
   ///
-  /// Needs every contact between discs (no deal.II first body: share_of refuses half-discs).
   /// Memory and the detection and update are not divided by the ranks (docs/scaling.md).
   class SolveAcrossRanks : public ContactSolver
   {
@@ -46,6 +49,9 @@ namespace tribo::dem::parallel
     void        set_random_state(const std::string &) override {}
 
   private:
+    /// RunError unless @p state's boundary node velocities are the same bits on every rank.
+    void check_same_nodes(const BodyState &state) const;
+
     const ParticleSystem          &system;
     MPI_Comm                       comm;
     std::unique_ptr<ContactSolver> whole; ///< the method whole, for the steps with few contacts

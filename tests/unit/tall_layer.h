@@ -12,8 +12,9 @@ namespace tribo::dem::test
 
   /// A hexagonal stack of @p columns x @p rows discs (d = 1 um, 2 % gaps) between a sliding
   /// lower wall (1 m/s) and an upper wall loaded by 100 N/m per column, period @p columns um:
-  /// 8 x 24 is tall enough for four bands of contacts.
-  inline ParticleSystem tall_layer(int columns = 8, int rows = 24)
+  /// 8 x 24 is tall enough for four bands of contacts. Without @p upper_wall, the stack's
+  /// top is free (for a boundary body instead).
+  inline ParticleSystem tall_layer(int columns = 8, int rows = 24, bool upper_wall = true)
   {
     ParticleSystem s;
     s.period = columns * 1e-6;
@@ -32,6 +33,8 @@ namespace tribo::dem::test
     for (int j = 0; j < rows; ++j)
       for (int i = 0; i < columns; ++i)
         s.add_disc({(i + 0.5 * (j % 2)) * 1.02e-6, 1.02e-6 + j * dy}, radius, rho);
+    if (!upper_wall)
+      return s;
     for (auto &p : c)
       p.y() = 1.02e-6 + rows * dy;
     const unsigned upper = s.add_clump(c, rad, rho);

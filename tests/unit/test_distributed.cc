@@ -3,6 +3,8 @@
 // failure on one rank cannot leave the others waiting.
 #include "dem/parallel/distributed_apgs.h"
 #include "dem/parallel/distributed_gauss_seidel.h"
+#include "dem/solvers/nlgs.h"
+#include "tests/unit/lumped_chain.h"
 #include "tests/unit/tall_layer.h"
 
 #include <deal.II/base/mpi.h>
@@ -360,6 +362,111 @@ TEST(Distributed, NlgsStopsAsTheSerialNlgsAndGivesItsAnswerOnEveryRankCount)
         }
       std::cout << "[ measure  ] NLGS's test, " << n_ranks() << " ranks, tolerance " << tolerance << ": "
                 << here.report.sweeps << " sweeps (serial NLGS " << nlgs.iterations << ")" << std::endl;
+    }
+}
+
+namespace
+{
+  /// A step's problem as MoreauJean hands it to its solver (the contacts, and the state with
+  /// the boundary bodies' nodes and compliance), kept; NLGS solves the step.
+  class KeepingSolver : public ContactSolver
+  {
+  public:
+    KeepingSolver()
+      : ContactSolver(fixed_sweeps(500))
+      , nlgs(prm)
+    {}
+    SolveReport solve(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law,
+                      double theta_h) override
+    {
+      kept_contacts = contacts;
+      kept_state    = state;
+      return nlgs.solve(contacts, state, law, theta_h);
+    }
+    bool        solves_friction() const override { return true; }
+    std::string random_state() const override { return ""; }
+    void        set_random_state(const std::string &) override {}
+
+    NlgsSolver           nlgs;
+    std::vector<Contact> kept_contacts;
+    BodyState            kept_state;
+  };
+
+  /// tall_layer's grains under a chain of lumped masses (a deformable first body's boundary,
+  /// dem/engine/boundary.h) instead of the upper wall, pressed onto them at 1 m/s: the 20th
+  /// step's problem, cold (its impulses taken back out of the state).
+  struct UnderChain
+  {
+    ParticleSystem       system = tall_layer(8, 24, false);
+    // The top row's centres at 1.02 um + 23 dy, the half-discs' (d = 1 um) lowest points
+    // 5 nm above its discs.
+    LumpedChain          chain{8, 8e-6, 1.02e-6 + 23 * 1.02e-6 * std::sqrt(3.0) / 2 + 1.005e-6, 1e-8, {0, -100}};
+    std::vector<Contact> contacts;
+    BodyState            state;
+    explicit UnderChain(const ContactLaw &law)
+    {
+      for (Vec2 &v : chain.v)
+        v = {0, -1};
+      MoreauJean mj(0.5, law, fixed_sweeps(500), 5e-8);
+      mj.attach(chain, 1e-6, {0, -1}, system.period);
+      auto keeping = std::make_unique<KeepingSolver>();
+      KeepingSolver &kept = *keeping;
+      mj.use_solver(std::move(keeping));
+      for (int i = 0; i < 20; ++i)
+        mj.step(system, 1e-9);
+      contacts = kept.kept_contacts;
+      state    = kept.kept_state;
+      for (Contact &c : contacts)
+        {
+          state.apply_impulse(c, -c.r);
+          c.r.setZero();
+        }
+    }
+  };
+} // namespace
+
+TEST(Distributed, HalfDiscContactsAreSolvedOnTheTopBandAndGiveTheSerialAnswer)
+{
+  // A deformable first body's half-disc contacts all belong to the top band (one rank holds
+  // the body's nodes); the grains' and the nodes' velocities are the serial ones, which the
+  // step's problem makes unique without friction (docs/validation.md).
+  const UnderChain cold{ContactLaw{}};
+  unsigned int     on_chain = 0;
+  for (const Contact &c : cold.contacts)
+    on_chain += c.on_boundary();
+  ASSERT_GE(on_chain, 8u);
+  std::vector<Contact> serial = cold.contacts;
+  BodyState            serial_state = cold.state;
+  SolverParameters     tight;
+  tight.method         = SolverParameters::Method::nlgs;
+  tight.tolerance      = 1e-12;
+  tight.max_iterations = 200000;
+  NlgsSolver(tight).solve(serial, serial_state, ContactLaw{});
+
+  for (const Sweeps sweeps : {Sweeps::gauss_seidel, Sweeps::apgs})
+    {
+      RankProblem p = share_of(cold.system, cold.contacts, cold.state,
+                               contact_bands(cold.system, cold.contacts, n_ranks()), my_rank());
+      unsigned int mine = 0;
+      for (const Contact &c : p.contacts)
+        mine += c.on_boundary();
+      DistributedControls controls;
+      controls.residual_target = 1e-9;
+      controls.max_sweeps      = 100000;
+      const DistributedReport report = sweeps == Sweeps::apgs ? DistributedApgs(p, world()).solve(p, ContactLaw{}, controls)
+                                                              : DistributedGaussSeidel(p, world()).solve(p, ContactLaw{}, controls);
+      const std::vector<Eigen::Vector3d> velocity = gathered_velocities(p, cold.system.bodies.size());
+      Eigen::VectorXd nodes = my_rank() + 1 == n_ranks() ? p.state.node_velocity : Eigen::VectorXd::Zero(cold.state.node_velocity.size());
+      MPI_Bcast(nodes.data(), int(nodes.size()), MPI_DOUBLE, int(n_ranks() - 1), world());
+
+      EXPECT_EQ(mine, my_rank() + 1 == n_ranks() ? on_chain : 0u);
+      EXPECT_TRUE(report.converged);
+      double worst = 0;
+      for (std::size_t b = 0; b < velocity.size(); ++b)
+        worst = std::max(worst, (velocity[b] - serial_state.velocity[b]).head<2>().lpNorm<Eigen::Infinity>());
+      EXPECT_LT(worst, 1e-6) << (sweeps == Sweeps::apgs ? "APGS sweeps" : "Gauss-Seidel");
+      EXPECT_LT((nodes - serial_state.node_velocity).lpNorm<Eigen::Infinity>(), 1e-6)
+        << (sweeps == Sweeps::apgs ? "APGS sweeps" : "Gauss-Seidel");
     }
 }
 
