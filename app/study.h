@@ -3,8 +3,8 @@
 /// run as cases of one base case, one case per MPI rank at a time (or one after
 /// another without mpirun), resumable, summarised in one table. With more ranks than
 /// cases (and no tradeoff design), each case runs on a group of ranks, its contact solve
-/// split over them (docs/scaling.md), when every case can be split (Solver/Method = apgs, a
-/// disc scene, no deformable first body); otherwise one rank per case still.
+/// split over them (docs/scaling.md), when every case can be split (Solver/Method = apgs or
+/// nlgs, a disc scene, no particle first body); otherwise one rank per case still.
 ///
 /// A study file:
 ///
