@@ -7,7 +7,7 @@ the fastest body (m/s) and the worst overlap over the smallest radius.
 Over a run, frictionless IQS contacts without cohesion take energy. A single step may give
 a little back even when solved exactly: at midpoint velocities, a contact that opens at the
 step's start while the load closes it does positive work. Much more than converged solves
-give back points at the solve (docs/performance.md, "A wall landing during the shear").
+give back points at the solve (docs/robustness.md, "A wall landing during the shear").
 
 Usage: contact_work.py RUN_DIRECTORY...
 """
