@@ -20,7 +20,7 @@ namespace tribo::app
   {
     dem::ParticleSystem     &system;
     const dem::MoreauJean   *integrator = nullptr; ///< null until built
-    dem::StepReport          report;               ///< of the last step
+    dem::StepReport          report{};             ///< of the last step
     unsigned long            step = 0;             ///< before_step(): the step about to run
   };
 
