@@ -23,7 +23,7 @@ Usage:
       Run a case; outputs go to DIR (default output/<case name>), see docs/outputs.md.
   mpirun -np N tribo run CASE.prm ...
       One disc case on N ranks: each step's contact solve split into N horizontal bands
-      (Solver/Method = apgs or nlgs; no sph or mlp first body); rank 0 writes (docs/scaling.md).
+      (Solver/Method = apgs or nlgs); rank 0 writes (docs/scaling.md).
   tribo run CASE.prm --resume DIR [--set ...] [--quiet]
       Continue the run in DIR from its checkpoint.bin (Output/Checkpoint interval); only
       Solver/*, Output/*, Simulation/End time and Shear cell/Upper body prediction depth

@@ -162,10 +162,6 @@ namespace tribo::app
                        p.solver.section.entry("Streams") + ": on " + std::to_string(ranks) +
                        " MPI ranks NLGS sweeps each rank's contacts in detection order (docs/scaling.md); "
                        "set them to fixed and 1, or run the case without mpirun");
-    if (ranks > 1 && !coupling::runs_across_ranks(file.get("Shear cell/Upper body model")))
-      throw InputError(o.case_file + ": Shear cell/Upper body model = " + file.get("Shear cell/Upper body model") +
-                       ": a particle first body runs in one process (docs/scaling.md); run the case without "
-                       "mpirun");
     if (o.check_only)
       {
         if (!o.quiet)

@@ -397,7 +397,7 @@ namespace tribo::app
 
     /// Whether every case (@p overrides of @p base) and preparation may run on several MPI
     /// ranks: `tribo check` of each on all of them passes run_case()'s refusals (a Solver/Method
-    /// other than apgs and nlgs, NLGS in another order, a scene or first body that is not split).
+    /// other than apgs and nlgs, NLGS in another order, a scene that is not split).
     bool every_case_splits(const fs::path &base, const std::vector<std::vector<std::string>> &overrides,
                            const std::vector<std::vector<std::string>> &preparations)
     {

@@ -4,7 +4,7 @@
 /// another without mpirun), resumable, summarised in one table. With more ranks than
 /// cases (and no tradeoff design), each case runs on a group of ranks, its contact solve
 /// split over them (docs/scaling.md), when every case can be split (Solver/Method = apgs or
-/// nlgs, a disc scene, no particle first body); otherwise one rank per case still.
+/// nlgs, a disc scene); otherwise one rank per case still.
 ///
 /// A study file:
 ///

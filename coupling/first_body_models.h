@@ -12,12 +12,6 @@ namespace tribo::coupling
   /// file or a shared compaction carries it too. InputError for an unknown model.
   bool is_wall_of_discs(const std::string &model);
 
-  /// Whether a case with model @p model runs on N MPI ranks (docs/scaling.md): a wall of
-  /// discs, or a body whose update every rank repeats bit for bit (the deal.II body and its
-  /// reduction: sequential assembly order, CHOLMOD), its half-disc contacts solved by the
-  /// rank of the top band. The particle bodies (sph, mlp) run in one process.
-  bool runs_across_ranks(const std::string &model);
-
   /// The first-body entries (of the subsection that declares them, without its name) that a
   /// resumed run may change, for any model: entries that say only how the contact solve
   /// predicts a body, not how the body moves.

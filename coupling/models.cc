@@ -22,9 +22,8 @@ namespace tribo::coupling
     /// The upper first-body models (the Upper body model entry): name, least number of
     /// chain nodes, the build option of their module, how the scene's placement makes them,
     /// the deformable body (null for a wall of discs and when the build left the module
-    /// out), the model's own check of the parameters (null: none), whether the model is
-    /// a wall of discs (is_wall_of_discs()), and whether a case with it runs on N MPI ranks
-    /// (runs_across_ranks()).
+    /// out), the model's own check of the parameters (null: none), and whether the model is
+    /// a wall of discs (is_wall_of_discs()).
     struct FirstBodyModel
     {
       const char *name;
@@ -34,7 +33,6 @@ namespace tribo::coupling
       std::unique_ptr<DeformableBody> (*make_deformable)(const FirstBodyParameters &);
       void (*check)(const FirstBodyParameters &);
       bool wall_of_discs = false;
-      bool across_ranks  = false;
     };
 
 #ifdef TRIBO_WITH_FEM
@@ -54,9 +52,9 @@ namespace tribo::coupling
 #endif
 
     const FirstBodyModel models[] = {
-      {"rigid", 0, "", place_rigid_wall, nullptr, nullptr, true, true},
-      {"fem", 1, "TRIBO_WITH_FEM", place_on_half_discs, fem_body, check_fem_body, false, true},
-      {"reduced", 1, "TRIBO_WITH_FEM", place_on_half_discs, fem_body, check_fem_body, false, true},
+      {"rigid", 0, "", place_rigid_wall, nullptr, nullptr, true},
+      {"fem", 1, "TRIBO_WITH_FEM", place_on_half_discs, fem_body, check_fem_body},
+      {"reduced", 1, "TRIBO_WITH_FEM", place_on_half_discs, fem_body, check_fem_body},
       {"sph", 8, "TRIBO_WITH_SPH", place_on_half_discs, sph_body, nullptr},
       {"mlp", 4, "TRIBO_WITH_MLP", place_on_half_discs, mlp_body, check_mlp_body},
     };
@@ -92,8 +90,6 @@ namespace tribo::coupling
   } // namespace
 
   bool is_wall_of_discs(const std::string &model) { return model_of(model).wall_of_discs; }
-
-  bool runs_across_ranks(const std::string &model) { return model_of(model).across_ranks; }
 
   const std::vector<std::string> &entries_that_may_change_on_resume()
   {
