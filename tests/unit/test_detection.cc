@@ -71,7 +71,9 @@ namespace
     EXPECT_EQ(found, expected);
     EXPECT_GT(expected.size(), 100u);
     if (speed > 0) // the motions add pairs beyond the distance
-      EXPECT_GT(expected.size(), brute_force(s, x, 1e-7).size() + 20);
+      {
+        EXPECT_GT(expected.size(), brute_force(s, x, 1e-7).size() + 20);
+      }
   }
 } // namespace
 
