@@ -63,5 +63,4 @@ namespace tribo::dem::test
     std::vector<Vec2> x, v, v_free;
     Eigen::MatrixXd   G;
   };
-
 } // namespace tribo::dem::test
