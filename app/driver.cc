@@ -170,7 +170,7 @@ namespace tribo::app
       {
         if (sim.row_at_start())
           stats.add(sim, step);
-        if (writes)
+        if (writes || sim.snapshot_on_every_rank())
           sim.write_snapshot(fields);
       }
 
@@ -196,7 +196,7 @@ namespace tribo::app
             const bool last = sim.reached_end(step) || sim.finished();
             if (last || sim.row_due(step))
               stats.add(sim, step);
-            if (writes && !last && sim.snapshot_due(step))
+            if ((writes || sim.snapshot_on_every_rank()) && !last && sim.snapshot_due(step))
               sim.write_snapshot(fields);
             const auto now = std::chrono::steady_clock::now();
             if (writes && std::chrono::duration<double>(now - last_flush).count() > 10)
@@ -226,7 +226,7 @@ namespace tribo::app
     // The last step done gets its row, whatever the interval, and its snapshot.
     if (!stats.has_row_of(step))
       stats.add(sim, step);
-    if (writes && (status != "failed" || sim.snapshot_a_failed_state()))
+    if ((writes || sim.snapshot_on_every_rank()) && (status != "failed" || sim.snapshot_a_failed_state()))
       sim.write_snapshot(fields);
 
     const double wall = checkpoint.wall_time();

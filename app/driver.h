@@ -137,6 +137,9 @@ namespace tribo::app
     virtual bool snapshot_due(unsigned long step) = 0;
     /// Write a field snapshot of the state now into @p fields.
     virtual void write_snapshot(FieldWriter &fields) = 0;
+    /// True when every MPI rank of the run writes its piece of a snapshot (write_snapshot()
+    /// is then collective); otherwise only the first rank calls it.
+    virtual bool snapshot_on_every_rank() const { return false; }
     /// False when a failed run's last state is not worth a snapshot (a body flown apart).
     virtual bool snapshot_a_failed_state() const { return true; }
     /// Number of snapshots written (summary.json "n_field_snapshots").

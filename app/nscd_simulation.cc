@@ -261,14 +261,34 @@ namespace tribo::app
         return prm.field_interval > 0 && s % prm.field_interval == 0;
       }
 
+      /// On N ranks each rank writes the discs of one band of equal disc counts (by the height
+      /// of their centres) and the loaded contacts whose midpoint lies in it, as its piece of
+      /// the snapshot; the first rank then writes the .pvtu records, the .pvd indices, the
+      /// sample and the scene's own fields.
       void write_snapshot(FieldWriter &writer) override
       {
-        const auto &s = system;
-        DiscField   discs;
+        const auto        &s     = system;
+        const unsigned int ranks = rank_count(prm.ranks), rank = rank_in(prm.ranks);
+        std::vector<double> cuts; // the bands' upper edges but the last's, m
+        if (ranks > 1)
+          {
+            std::vector<double> heights;
+            for (std::size_t d = 0; d < s.discs.size(); ++d)
+              heights.push_back(s.wrap(s.disc_centre(d)).y());
+            std::sort(heights.begin(), heights.end());
+            for (unsigned int k = 1; k < ranks; ++k)
+              cuts.push_back(heights[k * heights.size() / ranks]);
+          }
+        const auto mine = [&](double y) {
+          return ranks == 1 || std::upper_bound(cuts.begin(), cuts.end(), y) - cuts.begin() == long(rank);
+        };
+        DiscField discs;
         for (std::size_t d = 0; d < s.discs.size(); ++d)
           {
             const auto &b   = s.bodies[s.discs[d].body];
             const auto  x   = s.wrap(s.disc_centre(d));
+            if (!mine(x.y()))
+              continue;
             const auto  arm = dem::rotate(s.discs[d].offset, b.angle);
             discs.x.push_back(x.x());
             discs.y.push_back(x.y());
@@ -284,6 +304,8 @@ namespace tribo::app
             if (c.r.x() == 0 && c.r.y() == 0)
               continue;
             const auto x0 = s.wrap(s.disc_centre(c.disc[0]));
+            if (!mine(x0.y() + 0.5 * c.branch.y()))
+              continue;
             contacts.x0.push_back(x0.x());
             contacts.y0.push_back(x0.y());
             contacts.x1.push_back(x0.x() + c.branch.x());
@@ -292,7 +314,14 @@ namespace tribo::app
             contacts.tangential_force.push_back(c.r.y() / h);
             contacts.gap.push_back(c.gap);
           }
-        writer.write(time(), discs, contacts);
+        writer.write(time(), discs, contacts, {rank, ranks});
+        if (ranks > 1)
+          {
+            MPI_Barrier(prm.ranks); // every piece on disk before the records name it
+            if (rank > 0)
+              return;
+            writer.write_piece_records(ranks);
+          }
         // The discs as a sample file next to the snapshot (`tribo sample DIR --time T`),
         // exact where the VTU's Float32 is not.
         if (const std::string sample = scene->sample(s); !sample.empty())
@@ -302,6 +331,7 @@ namespace tribo::app
           writer.index(file.substr(0, file.rfind('_')), time(), file);
       }
       unsigned int n_snapshots(const FieldWriter &fields) const override { return fields.n_snapshots(); }
+      bool         snapshot_on_every_rank() const override { return rank_count(prm.ranks) > 1; }
 
       std::string resumed_line(unsigned long s) const override
       {

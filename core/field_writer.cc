@@ -14,6 +14,7 @@
 
 #include <cstdio>
 #include <sstream>
+#include <tuple>
 
 namespace tribo
 {
@@ -58,12 +59,18 @@ namespace tribo
       return os.str();
     }
 
-    std::string numbered(const std::string &stem, std::size_t n)
+    /// STEM_NNNNN.vtu, or with @p suffix STEM_NNNNN.SUFFIX (a piece "I.vtu", a record "pvtu").
+    std::string numbered(const std::string &stem, std::size_t n, const std::string &suffix = "vtu")
     {
       char buf[32];
-      std::snprintf(buf, sizeof buf, "_%05zu.vtu", n);
-      return stem + buf;
+      std::snprintf(buf, sizeof buf, "_%05zu.", n);
+      return stem + buf + suffix;
     }
+
+    const std::vector<std::string> disc_names    = {"radius", "velocity", "velocity", "spin", "body"};
+    const std::vector<std::string> contact_names = {"normal_force", "tangential_force", "gap"};
+    const Ranges                   disc_ranges   = {
+      {1, 2, "velocity", dealii::DataComponentInterpretation::component_is_part_of_vector}};
 
     std::string pvd_text(const std::vector<std::pair<double, std::string>> &files)
     {
@@ -77,7 +84,7 @@ namespace tribo
     : dir(std::move(directory))
   {}
 
-  void FieldWriter::write(double t, const DiscField &discs, const ContactField &contacts)
+  void FieldWriter::write(double t, const DiscField &discs, const ContactField &contacts, FieldPiece piece)
   {
     const std::size_t n = times.size();
 
@@ -95,8 +102,6 @@ namespace tribo
         p.data(3, 0) = discs.spin[i];
         p.data(4, 0) = discs.body[i];
       }
-    const Ranges disc_ranges = {
-      {1, 2, "velocity", dealii::DataComponentInterpretation::component_is_part_of_vector}};
 
     // Contacts: one line patch per contact, from centre to centre.
     std::vector<dealii::DataOutBase::Patch<1, 2>> contact_patches(contacts.x0.size());
@@ -116,17 +121,38 @@ namespace tribo
           }
       }
 
-    const std::string disc_file    = numbered("discs", n);
-    const std::string contact_file = numbered("contacts", n);
-    atomic_write(dir + "/" + disc_file,
-                 vtu_text_of(disc_patches, {"radius", "velocity", "velocity", "spin", "body"},
-                             disc_ranges));
-    atomic_write(dir + "/" + contact_file,
-                 vtu_text_of(contact_patches, {"normal_force", "tangential_force", "gap"}, {}));
+    // One process: the snapshot's files; several: this one's piece, indexed by the records.
+    const bool        whole       = piece.count <= 1;
+    const std::string piece_name  = std::to_string(piece.index) + ".vtu";
+    const std::string disc_file   = numbered("discs", n, whole ? "vtu" : piece_name);
+    const std::string contact_file = numbered("contacts", n, whole ? "vtu" : piece_name);
+    atomic_write(dir + "/" + disc_file, vtu_text_of(disc_patches, disc_names, disc_ranges));
+    atomic_write(dir + "/" + contact_file, vtu_text_of(contact_patches, contact_names, {}));
 
     times.push_back(t);
-    disc_files.emplace_back(t, disc_file);
-    contact_files.emplace_back(t, contact_file);
+    disc_files.emplace_back(t, whole ? disc_file : numbered("discs", n, "pvtu"));
+    contact_files.emplace_back(t, whole ? contact_file : numbered("contacts", n, "pvtu"));
+    if (whole)
+      {
+        atomic_write(dir + "/discs.pvd", pvd_text(disc_files));
+        atomic_write(dir + "/contacts.pvd", pvd_text(contact_files));
+      }
+  }
+
+  void FieldWriter::write_piece_records(unsigned int count) const
+  {
+    const std::size_t n = times.size() - 1;
+    dealii::DataOutBase::VtkFlags flags;
+    for (const auto &[stem, names, ranges] :
+         {std::tuple{"discs", disc_names, disc_ranges}, std::tuple{"contacts", contact_names, Ranges{}}})
+      {
+        std::vector<std::string> pieces;
+        for (unsigned int i = 0; i < count; ++i)
+          pieces.push_back(numbered(stem, n, std::to_string(i) + ".vtu"));
+        std::ostringstream os;
+        dealii::DataOutBase::write_pvtu_record(os, pieces, names, ranges, flags);
+        atomic_write(dir + "/" + numbered(stem, n, "pvtu"), os.str());
+      }
     atomic_write(dir + "/discs.pvd", pvd_text(disc_files));
     atomic_write(dir + "/contacts.pvd", pvd_text(contact_files));
   }

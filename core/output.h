@@ -95,14 +95,27 @@ namespace tribo
     std::vector<double> x0, y0, x1, y1, normal_force, tangential_force, gap;
   };
 
+  /// Part @p index of @p count of a field snapshot that several processes (MPI ranks) write.
+  struct FieldPiece
+  {
+    unsigned int index = 0, count = 1;
+  };
+
   /// The fields/ directory: numbered VTU snapshots and their .pvd indices.
   class FieldWriter
   {
   public:
     explicit FieldWriter(std::string directory = "");
     /// Write discs_NNNNN.vtu and contacts_NNNNN.vtu for time @p t and rewrite
-    /// discs.pvd and contacts.pvd.
-    void write(double t, const DiscField &discs, const ContactField &contacts);
+    /// discs.pvd and contacts.pvd. With @p piece.count > 1, this process's part only,
+    /// discs_NNNNN.I.vtu and contacts_NNNNN.I.vtu (I = piece.index): the snapshot is
+    /// indexed as discs_NNNNN.pvtu and contacts_NNNNN.pvtu, which write_piece_records()
+    /// writes once every piece is on disk.
+    void write(double t, const DiscField &discs, const ContactField &contacts, FieldPiece piece = {});
+    /// Once every process has written its piece of the last snapshot (one process calls
+    /// it): the .pvtu records of that snapshot, naming its @p count pieces, and the .pvd
+    /// indices.
+    void write_piece_records(unsigned int count) const;
     /// Add @p file (already written in the directory) at time @p t to the index
     /// SERIES.pvd, e.g. the snapshots of a deformable body next to the discs.
     void index(const std::string &series, double t, const std::string &file);

@@ -2,7 +2,10 @@
 
 - on two ranks the 120-disc shear cell gives the serial run's friction, stress, solid fraction
   and power balance within their combined standard errors, every step within the solver's
-  law residual target, and one set of outputs (rank 0 writes, the others say nothing);
+  law residual target, and one set of outputs (rank 0 writes, the others say nothing); each
+  rank writes its band of the discs and loaded contacts as a piece of each field snapshot,
+  indexed by .pvtu records: the first snapshot holds the serial run's discs exactly, the last
+  every disc and every loaded contact once;
 - a checkpoint written on two ranks (stopped by SIGTERM) resumes on one rank (to the end)
   and on three (300 steps): the rows before the checkpoint are kept bit for bit and both
   complete within the residual target;
@@ -29,9 +32,11 @@ import subprocess
 import sys
 import time
 
+import numpy as np
+
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import tribo_cli  # noqa: E402
-from tribo_cli import TempDirTestCase, read_json, run, write_prm  # noqa: E402
+from tribo_cli import TempDirTestCase, pvtu_pieces, read_json, read_pvd, read_vtu_with_vtk, run, write_prm  # noqa: E402
 
 #: cases/shear/small.prm without plots: 120 discs, 8000 steps, APGS to a law residual of 3e-3.
 TARGET = 3e-3
@@ -106,6 +111,44 @@ class Ranks(TempDirTestCase):
         self.assertEqual(one["timing"]["exchange_mean_s"], 0)
         self.assertGreater(two["timing"]["exchange_mean_s"], 0)
         self.assertLess(two["timing"]["exchange_mean_s"], two["timing"]["solver_mean_s"])
+        self.assert_fields_in_pieces(one, two)
+
+    def assert_fields_in_pieces(self, one, two):
+        """Each rank writes a band of the discs and of the loaded contacts as its piece of a
+        snapshot, indexed by a .pvtu record: at the start the serial run's discs exactly, at
+        the end every disc once and every loaded contact once."""
+        fields = {out: os.path.join(self.tmp, out, "fields") for out in ("one", "two")}
+        snapshots = {out: {kind: read_pvd(os.path.join(fields[out], kind + ".pvd")) for kind in ("discs", "contacts")}
+                     for out in fields}
+        self.assertEqual([t for t, _ in snapshots["one"]["discs"]], [t for t, _ in snapshots["two"]["discs"]])
+        self.assertEqual(two["n_field_snapshots"], len(snapshots["two"]["discs"]))
+        for kind in ("discs", "contacts"):
+            for t, name in snapshots["two"][kind]:
+                record = os.path.join(fields["two"], name)
+                self.assertTrue(name.endswith(".pvtu"), name)
+                self.assertEqual([os.path.basename(p) for p in pvtu_pieces(record)],
+                                 [name.replace(".pvtu", ".%d.vtu" % i) for i in range(2)])
+
+        def discs(out, index):
+            d = read_vtu_with_vtk(self, os.path.join(fields[out], snapshots[out]["discs"][index][1]))
+            columns = [d["points"][:, 0], d["points"][:, 1], d["point_data"]["radius"][:, 0],
+                       d["point_data"]["body"][:, 0]]
+            return np.array(sorted(zip(*columns)))
+
+        first_one, first_two = discs("one", 0), discs("two", 0)
+        self.assertEqual(first_two.shape, (two["n_discs"], 4))
+        np.testing.assert_array_equal(first_one, first_two)
+        last = discs("two", -1)
+        self.assertEqual(len(last), two["n_discs"])
+        self.assertEqual(len(np.unique(last[:, :2], axis=0)), two["n_discs"])  # no disc twice
+        # The pieces are bands: every disc of rank 0's piece below every disc of rank 1's.
+        record = os.path.join(fields["two"], snapshots["two"]["discs"][-1][1])
+        low, high = (read_vtu_with_vtk(self, piece)["points"][:, 1] for piece in pvtu_pieces(record))
+        self.assertEqual(len(low) + len(high), two["n_discs"])
+        self.assertLessEqual(low.max(), high.min())
+        contacts = read_vtu_with_vtk(self, os.path.join(fields["two"], snapshots["two"]["contacts"][-1][1]))
+        rows = statistics(os.path.join(self.tmp, "two"))
+        self.assertEqual(contacts["n_cells"], int(float(rows[-1][rows[0].index("n_active_contacts")])))
 
     def test_the_deal_ii_first_body_on_two_ranks_gives_the_serial_friction(self):
         # At a law residual of 1e-5: at the case's 3e-3 the friction moves with the solve's

@@ -228,21 +228,30 @@ def decode_vtu(path):
     return out
 
 
+def pvtu_pieces(path):
+    """The piece files a .pvtu record names, as paths next to it."""
+    root = ET.parse(path).getroot()
+    return [os.path.join(os.path.dirname(path), p.get("Source")) for p in root.iter("Piece")]
+
+
 def read_vtu_with_vtk(testcase, path):
-    """Read @p path with VTK's vtkXMLUnstructuredGridReader, failing @p testcase if
-    the file is malformed (checked first without VTK, which can crash on such
-    files) or if VTK reports an error or a warning.
+    """Read @p path with VTK's vtkXMLUnstructuredGridReader (a .pvtu record and its pieces
+    with vtkXMLPUnstructuredGridReader), failing @p testcase if a file is malformed
+    (checked first without VTK, which can crash on such files) or if VTK reports an error
+    or a warning.
 
     Returns {"n_points", "n_cells", "points", "cell_types", "point_data": {name: n x c array}}.
     """
-    problems = decode_vtu(path)["problems"]
-    testcase.assertEqual(problems, [], "%s is not a valid VTU file" % os.path.basename(path))
+    parallel = path.endswith(".pvtu")
+    for piece in pvtu_pieces(path) if parallel else [path]:
+        problems = decode_vtu(piece)["problems"]
+        testcase.assertEqual(problems, [], "%s is not a valid VTU file" % os.path.basename(piece))
 
-    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+    from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader, vtkXMLUnstructuredGridReader
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     events = []
-    reader = vtkXMLUnstructuredGridReader()
+    reader = vtkXMLPUnstructuredGridReader() if parallel else vtkXMLUnstructuredGridReader()
     reader.AddObserver("ErrorEvent", lambda obj, ev: events.append(ev))
     reader.AddObserver("WarningEvent", lambda obj, ev: events.append(ev))
     reader.SetFileName(path)
