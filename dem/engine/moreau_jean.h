@@ -152,8 +152,8 @@ namespace tribo::dem
 
   private:
     /// The law residual and gap violation of the solve that produced @p report (the residual
-    /// too, unless NLGS solved the step), and the step not converged above
-    /// SolverParameters::gap_target.
+    /// too, unless NLGS solved the step; the solve's own when it reports them,
+    /// SolveReport::law_assessed), and the step not converged above SolverParameters::gap_target.
     void assess_solve(double h, SolveReport &report) const;
 
     // The phases of step(), in order (see the file comment).

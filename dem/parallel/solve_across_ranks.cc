@@ -133,6 +133,9 @@ namespace tribo::dem::parallel
     report.iterations    = done.sweeps;
     report.check_passes  = done.checks;
     report.law_residual   = done.law_residual;
+    // APGS's sweeps end with the law residual over all ranks of the answer they return
+    // (DistributedApgs); NLGS's stop by NLGS's own norm.
+    report.law_assessed   = !nlgs;
     report.residual       = nlgs ? done.nlgs_residual : done.law_residual;
     report.solved_by_nlgs = nlgs;
     report.gap_violation = done.gap_violation;

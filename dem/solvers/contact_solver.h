@@ -151,6 +151,10 @@ namespace tribo::dem
     /// The law residual after the solve (dem/laws/law_residual.h), max |phi| / mean loaded
     /// impulse: the same measure whatever the method.
     double law_residual = 0;
+    /// Whether law_residual and gap_violation are already those of the answer returned,
+    /// over every contact, so that MoreauJean does not compute them again: a solve across
+    /// MPI ranks sums them over the ranks' shares (dem/parallel/solve_across_ranks.h).
+    bool law_assessed = false;
     /// Convergence checks done: passes of local solves that apply nothing, one every
     /// `check_interval` sweeps (their cost is part of the solver's time).
     unsigned int check_passes = 0;

@@ -3,6 +3,8 @@
 // failure on one rank cannot leave the others waiting.
 #include "dem/parallel/distributed_apgs.h"
 #include "dem/parallel/distributed_gauss_seidel.h"
+#include "dem/parallel/solve_across_ranks.h"
+#include "dem/laws/law_residual.h"
 #include "dem/solvers/nlgs.h"
 #include "tests/unit/lumped_chain.h"
 #include "tests/unit/tall_layer.h"
@@ -363,6 +365,30 @@ TEST(Distributed, NlgsStopsAsTheSerialNlgsAndGivesItsAnswerOnEveryRankCount)
       std::cout << "[ measure  ] NLGS's test, " << n_ranks() << " ranks, tolerance " << tolerance << ": "
                 << here.report.sweeps << " sweeps (serial NLGS " << nlgs.iterations << ")" << std::endl;
     }
+}
+
+TEST(Distributed, TheSolveAcrossRanksReportsTheLawResidualOfItsWholeAnswer)
+{
+  // MoreauJean takes the law residual of an APGS solve across ranks from the solve, which sums
+  // it over the ranks' shares: it is the law residual of the gathered answer over every
+  // contact, on every rank.
+  const ColdStart  cold;
+  SolverParameters prm;
+  prm.method          = SolverParameters::Method::apgs;
+  prm.residual_target = 1e-4;
+  prm.max_iterations  = 100000;
+  SolveAcrossRanks     solver(prm, cold.system, world());
+  std::vector<Contact> contacts = cold.contacts;
+  BodyState            state    = BodyState::of(cold.system);
+  const double         theta_h  = 0.5e-9;
+  ASSERT_GE(contacts.size(), std::size_t(SolveAcrossRanks::min_contacts_per_rank) * n_ranks());
+  const SolveReport r     = solver.solve(contacts, state, cold.law, theta_h);
+  const LawResidual whole = law_residual(contacts, state, cold.law, theta_h);
+  EXPECT_TRUE(r.law_assessed);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(r.law_residual, prm.residual_target);
+  EXPECT_NEAR(r.law_residual, whole.relative, 1e-9 * whole.relative);
+  EXPECT_NEAR(r.gap_violation, whole.gap_violation, 1e-9 * whole.gap_violation + 1e-30);
 }
 
 namespace
