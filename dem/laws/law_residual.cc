@@ -11,7 +11,7 @@ namespace tribo::dem
                            const ContactLaw &law, double theta_h)
   {
     LawResidual  result;
-    double       loaded_sum = 0, max_phi2 = 0, min_rate = 0;
+    double       loaded_sum = 0, max_phi2 = 0, min_rate = 0, velocity_sum = 0;
     unsigned int &loaded    = result.loaded;
     const bool   iqs        = law.type == ContactLaw::Type::iqs;
     for (std::size_t i = 0; i < contacts.size(); ++i)
@@ -39,15 +39,14 @@ namespace tribo::dem
             loaded_sum += rs;
             ++loaded;
           }
+        velocity_sum += std::abs(us) / (c.W(0, 0) + c.compliance);
         if (iqs)
           min_rate = std::min(min_rate, u.x() + c.shift);
       }
     result.max_phi       = std::sqrt(max_phi2);
-    result.mean_impulse  = loaded ? loaded_sum / loaded : 0;
-    // No loaded contact: any residual is the whole of the impulse that is missing.
-    result.relative      = result.mean_impulse > 0 ? result.max_phi / result.mean_impulse
-                           : result.max_phi > 0    ? 1.0
-                                                   : 0.0;
+    result.mean_impulse   = loaded ? loaded_sum / loaded : 0;
+    result.velocity_scale = contacts.empty() ? 0 : velocity_sum / double(contacts.size());
+    result.relative       = relative_law_residual(result.max_phi, result.mean_impulse, result.velocity_scale);
     result.gap_violation = theta_h * std::max(0.0, -min_rate);
     return result;
   }

@@ -13,6 +13,10 @@
 /// the Alart-Curnier map of the sliding law. The relative residual is
 ///     max_i |phi_i| / mean over loaded contacts (r~ > 0) of r~,
 /// so 1e-4 means the worst contact is one ten-thousandth of a mean impulse from its law.
+/// When no contact is loaded, the scale is the mean over the contacts of rho |u~| (N s/m),
+/// the impulse that would stop each one's normal velocity, which is then APGS's own scale
+/// (the mean |b_n| / (W_nn + C), dem/solvers/sweep_problem.h): a residual of 1.9e-17 N s/m
+/// among separating contacts had read as 1 against nothing.
 /// The gap violation is theta h max(0, -(u_n + b)) over the IQS contacts (m): how far the
 /// end-of-step gap is left below what the law allows.
 
@@ -32,10 +36,19 @@ namespace tribo::dem
     double max_phi       = 0; ///< max |phi| = max sqrt(phi_n^2 + phi_t^2), N s/m
     double mean_impulse  = 0; ///< mean r~ over the contacts with r~ > 0, N s/m
     unsigned int loaded  = 0; ///< contacts with r~ > 0 (mean_impulse's count)
+    /// Mean over the contacts of rho |u~| (N s/m): relative's scale when none is loaded.
+    double velocity_scale = 0;
     double gap_violation = 0; ///< theta h max(0, -(u_n + b)) over IQS contacts, m
     unsigned int worst   = 0; ///< index of the contact with the largest |phi|
   };
 
+  /// max |phi| over @p mean_impulse, or with nothing loaded over @p velocity_scale (the file
+  /// comment); 1 when both are 0 and max |phi| is not.
+  inline double relative_law_residual(double max_phi, double mean_impulse, double velocity_scale)
+  {
+    const double scale = mean_impulse > 0 ? mean_impulse : velocity_scale;
+    return scale > 0 ? max_phi / scale : max_phi > 0 ? 1.0 : 0.0;
+  }
   /// The residual of @p contacts (impulses c.r, law terms) against the velocities of
   /// @p state; @p theta_h = theta h (s) turns velocity violations into gap violations.
   LawResidual law_residual(const std::vector<Contact> &contacts, const BodyState &state,

@@ -111,16 +111,18 @@ namespace tribo::dem::parallel
     ++report.checks;
     report.reductions += 2;
     const LawResidual local     = law_residual(p.contacts, p.state, law, theta_h);
-    const double      loaded[2] = {local.mean_impulse * local.loaded, double(local.loaded)};
+    const double      loaded[4] = {local.mean_impulse * local.loaded, double(local.loaded),
+                                   local.velocity_scale * double(p.contacts.size()), double(p.contacts.size())};
     const double      maxima[2] = {local.max_phi, local.gap_violation};
-    double            global_max[2], global_loaded[2];
+    double            global_max[2], global_loaded[4];
     {
       const CommunicationTime timed(report);
       dealii::Utilities::MPI::max(maxima, comm, global_max);
       dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
     }
     const double mean    = global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : 0;
-    report.law_residual  = mean > 0 ? global_max[0] / mean : (global_max[0] > 0 ? 1 : 0);
+    const double scale   = global_loaded[3] > 0 ? global_loaded[2] / global_loaded[3] : 0;
+    report.law_residual  = relative_law_residual(global_max[0], mean, scale);
     report.gap_violation = global_max[1];
     return report.law_residual <= target;
   }

@@ -261,6 +261,35 @@ TEST(ContactSolvers, LawResidualIsZeroWhenSolvedAndPositiveWhenAContactIsLeftUns
   EXPECT_GT(unsolved.gap_violation, 0.0);
 }
 
+TEST(ContactSolvers, LawResidualWithNothingLoadedReadsAgainstTheContactsVelocities)
+{
+  // Every impulse of the solved stack removed: nothing is loaded, and the closing contacts'
+  // residual reads against the mean impulse that would stop the contacts' velocities, so it
+  // is large; a contact left closing slowly among separating ones is not.
+  ParticleSystem s = hexagonal_stack(400, 0);
+  const ContactLaw law;
+  MoreauJean     mj(0.5, law, active_set(), 0.1 * radius);
+  for (int i = 0; i < 20; ++i)
+    mj.step(s, h);
+  std::vector<Contact> contacts = mj.contacts();
+  BodyState            state    = BodyState::of(s);
+  for (Contact &c : contacts)
+    {
+      state.apply_impulse(c, -c.r);
+      c.r.setZero();
+    }
+  const LawResidual free = law_residual(contacts, state, law, 0.5 * h);
+  EXPECT_EQ(free.loaded, 0u);
+  EXPECT_GT(free.velocity_scale, 0.0);
+  EXPECT_GT(free.relative, 0.1);
+  EXPECT_DOUBLE_EQ(free.relative, free.max_phi / free.velocity_scale);
+  EXPECT_DOUBLE_EQ(relative_law_residual(1.9e-17, 0, 1e-9), 1.9e-8);
+  EXPECT_EQ(relative_law_residual(1e-17, 0, 0), 1.0);
+  EXPECT_EQ(relative_law_residual(0, 0, 0), 0.0);
+  EXPECT_DOUBLE_EQ(relative_law_residual(1e-3, 2.0, 1e-9), 5e-4); // loaded: the mean impulse
+  EXPECT_DOUBLE_EQ(relative_law_residual(1e-15, 1e-16, 1e-9), 10.0); // loaded, however little
+}
+
 TEST(ContactSolvers, ApgsPolishesOneWrongContactWithoutAWholeSweep)
 {
   // A converged wide stack (300 columns, about 2700 contacts) with the impulse of its most
