@@ -235,16 +235,33 @@ TEST(ContactSolvers, GlobalMethodsWithTheWallAsLowRankMatchConvergedNlgs)
     }
 }
 
+namespace
+{
+  /// The 400-disc stack after 20 steps solved by the active set: its contacts and state.
+  struct SolvedStack
+  {
+    ParticleSystem       s = hexagonal_stack(400, 0);
+    const ContactLaw     law;
+    std::vector<Contact> contacts;
+    BodyState            state;
+    SolvedStack()
+    {
+      MoreauJean mj(0.5, law, active_set(), 0.1 * radius);
+      for (int i = 0; i < 20; ++i)
+        mj.step(s, h);
+      contacts = mj.contacts();
+      state    = BodyState::of(s);
+    }
+  };
+} // namespace
+
 TEST(ContactSolvers, LawResidualIsZeroWhenSolvedAndPositiveWhenAContactIsLeftUnsolved)
 {
-  ParticleSystem s = hexagonal_stack(400, 0);
-  const ContactLaw law;
-  MoreauJean     mj(0.5, law, active_set(), 0.1 * radius);
-  for (int i = 0; i < 20; ++i)
-    mj.step(s, h);
-  std::vector<Contact> contacts = mj.contacts();
-  BodyState            state    = BodyState::of(s);
-  const LawResidual    solved   = law_residual(contacts, state, law, 0.5 * h);
+  SolvedStack           stack;
+  const ContactLaw     &law      = stack.law;
+  std::vector<Contact> &contacts = stack.contacts;
+  BodyState            &state    = stack.state;
+  const LawResidual     solved   = law_residual(contacts, state, law, 0.5 * h);
   EXPECT_GT(solved.mean_impulse, 0.0);
   EXPECT_LT(solved.relative, 1e-9);
   EXPECT_LT(solved.gap_violation, 1e-9 * radius);
@@ -266,19 +283,13 @@ TEST(ContactSolvers, LawResidualWithNothingLoadedReadsAgainstTheContactsVelociti
   // Every impulse of the solved stack removed: nothing is loaded, and the closing contacts'
   // residual reads against the mean impulse that would stop the contacts' velocities, so it
   // is large; a contact left closing slowly among separating ones is not.
-  ParticleSystem s = hexagonal_stack(400, 0);
-  const ContactLaw law;
-  MoreauJean     mj(0.5, law, active_set(), 0.1 * radius);
-  for (int i = 0; i < 20; ++i)
-    mj.step(s, h);
-  std::vector<Contact> contacts = mj.contacts();
-  BodyState            state    = BodyState::of(s);
-  for (Contact &c : contacts)
+  SolvedStack stack;
+  for (Contact &c : stack.contacts)
     {
-      state.apply_impulse(c, -c.r);
+      stack.state.apply_impulse(c, -c.r);
       c.r.setZero();
     }
-  const LawResidual free = law_residual(contacts, state, law, 0.5 * h);
+  const LawResidual free = law_residual(stack.contacts, stack.state, stack.law, 0.5 * h);
   EXPECT_EQ(free.loaded, 0u);
   EXPECT_GT(free.velocity_scale, 0.0);
   EXPECT_GT(free.relative, 0.1);
