@@ -197,6 +197,7 @@ namespace tribo::app
           changes = resume_changes(saved, file, o.resume_dir);
         },
         false);
+    std::string not_prepared;
     if (!resuming && writes)
       try
         {
@@ -210,9 +211,19 @@ namespace tribo::app
         }
       catch (const fs::filesystem_error &e)
         {
-          throw InputError("--output " + dir.string() + ": cannot prepare the directory (" +
-                           e.code().message() + ")");
+          not_prepared = "--output " + dir.string() + ": cannot prepare the directory (" + e.code().message() + ")";
         }
+    // On several ranks the others write their pieces of the fields into dir/fields: they wait
+    // until rank 0 has prepared it (or failed to).
+    if (ranks > 1)
+      {
+        int failed = !not_prepared.empty();
+        MPI_Bcast(&failed, 1, MPI_INT, 0, o.ranks);
+        if (failed && not_prepared.empty())
+          not_prepared = "--output " + dir.string() + ": rank 0 could not prepare the directory";
+      }
+    if (!not_prepared.empty())
+      throw InputError(not_prepared);
 
     JsonObject summary;
     summary.set("status", "running");
