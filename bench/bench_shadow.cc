@@ -17,6 +17,8 @@
 // solve's time per step.
 #include "bench/bench_case.h"
 
+#include "app/steady_state.h"
+
 #include "dem/laws/law_residual.h"
 #include "dem/solvers/methods.h"
 
@@ -104,25 +106,16 @@ namespace
     unsigned long                       calls = 0;
   };
 
-  /// Mean and standard error of @p x by batch means over @p batches batches.
-  std::pair<double, double> mean_and_error(const std::vector<double> &x, std::size_t batches)
+  /// Mean and standard error of @p x by batch means (app/steady_state.h, 10 batches).
+  std::pair<double, double> mean_and_error(const std::vector<double> &x)
   {
-    const std::size_t per = x.size() / batches;
-    if (per == 0)
-      throw std::runtime_error("fewer shadow samples than batches: run more steps");
-    std::vector<double> means(batches, 0.0);
-    for (std::size_t b = 0; b < batches; ++b)
-      {
-        for (std::size_t i = b * per; i < (b + 1) * per; ++i)
-          means[b] += x[i];
-        means[b] /= double(per);
-      }
-    double mean = 0, var = 0;
+    if (x.size() < 2 * app::standard_error_batches)
+      throw std::runtime_error("fewer than 20 shadow solves: run more steps");
+    const std::vector<double> means = app::batch_means(x);
+    double                    mean  = 0;
     for (const double m : means)
-      mean += m / double(batches);
-    for (const double m : means)
-      var += (m - mean) * (m - mean) / double(batches - 1);
-    return {mean, std::sqrt(var / double(batches))};
+      mean += m / double(means.size());
+    return {mean, app::batch_standard_error(means)};
   }
 } // namespace
 
@@ -181,12 +174,12 @@ int main(int argc, char **argv)
       res.push_back(sample.residual);
       ref_res.push_back(sample.reference_residual);
     }
-  const auto [mean_px, se_px] = mean_and_error(px, 10);
-  const auto [mean_py, se_py] = mean_and_error(py, 10);
-  const auto [mean_dx, se_dx] = mean_and_error(dx, 10);
-  const auto [mean_dy, se_dy] = mean_and_error(dy, 10);
-  const auto [mean_res, se_res] = mean_and_error(res, 10);
-  const auto [mean_ref, se_ref] = mean_and_error(ref_res, 10);
+  const auto [mean_px, se_px] = mean_and_error(px);
+  const auto [mean_py, se_py] = mean_and_error(py);
+  const auto [mean_dx, se_dx] = mean_and_error(dx);
+  const auto [mean_dy, se_dy] = mean_and_error(dy);
+  const auto [mean_res, se_res] = mean_and_error(res);
+  const auto [mean_ref, se_ref] = mean_and_error(ref_res);
   std::printf("steps %lu from step %lu, %zu shadow solves (every %u); case's solve %.2f ms per step, "
               "whole loop %.2f ms per step (with the shadows)\n",
               steps, first, shadow.samples.size(), every, 1e3 * shadow.solve_seconds / double(shadow.solves),
