@@ -381,9 +381,10 @@ TEST(Distributed, TheSolveAcrossRanksReportsTheLawResidualOfItsWholeAnswer)
   std::vector<Contact> contacts = cold.contacts;
   BodyState            state    = BodyState::of(cold.system);
   const double         theta_h  = 0.5e-9;
-  ASSERT_GE(contacts.size(), std::size_t(SolveAcrossRanks::min_contacts_per_rank) * n_ranks());
-  const SolveReport r     = solver.solve(contacts, state, cold.law, theta_h);
-  const LawResidual whole = law_residual(contacts, state, cold.law, theta_h);
+  const SolveReport    r        = solver.solve(contacts, state, cold.law, theta_h);
+  const LawResidual    whole    = law_residual(contacts, state, cold.law, theta_h);
+  // Enough contacts for the split (fewer are solved whole on every rank).
+  EXPECT_GE(contacts.size(), std::size_t(SolveAcrossRanks::min_contacts_per_rank) * n_ranks());
   EXPECT_TRUE(r.law_assessed);
   EXPECT_TRUE(r.converged);
   EXPECT_LE(r.law_residual, prm.residual_target);
