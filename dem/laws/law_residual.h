@@ -14,8 +14,9 @@
 ///     max_i |phi_i| / mean over loaded contacts (r~ > 0) of r~,
 /// so 1e-4 means the worst contact is one ten-thousandth of a mean impulse from its law.
 /// When no contact is loaded, the scale is the mean over the contacts of rho |u~| (N s/m),
-/// the impulse that would stop each one's normal velocity, which is then APGS's own scale
-/// (the mean |b_n| / (W_nn + C), dem/solvers/sweep_problem.h), so that a residual of
+/// the impulse that would stop each one's normal velocity (with every impulse 0 it is the
+/// scale APGS takes when its warm start has no loaded contact, the mean |b_n| / (W_nn + C),
+/// dem/solvers/sweep_problem.h), so that a residual of
 /// round-off size among separating contacts (1.9e-17 N s/m on an sph body's landing on two
 /// ranks) does not read as 1.
 /// The gap violation is theta h max(0, -(u_n + b)) over the IQS contacts (m): how far the
