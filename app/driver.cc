@@ -148,6 +148,7 @@ namespace tribo::app
     // After the header (RunCheckpoint): the step, the scene's state, the statistics and
     // the field index, in this order (core/checkpoint.h).
     const auto save_checkpoint = [&]() {
+      sim.prepare_checkpoint();
       if (writes)
         checkpoint.write([&](CheckpointOut &ar) {
         ar << step;

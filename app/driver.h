@@ -149,6 +149,9 @@ namespace tribo::app
     /// Results of the run (called once, after the last row and snapshot): the scene's
     /// entries of summary.json into @p summary, the rest into @p out.
     virtual void summarize(const RunEnd &end, JsonObject &summary, RunOutputs &out) = 0;
+    /// Collective on the run's MPI ranks, before every checkpoint, which the first rank
+    /// writes alone: gather onto it what save() needs from the others.
+    virtual void prepare_checkpoint() {}
     /// Checkpoint: the scene's state between steps (the driver saves the step number,
     /// the statistics and the field index around it).
     virtual void save(CheckpointOut &ar) const = 0;

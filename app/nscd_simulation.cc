@@ -4,6 +4,7 @@
 #include "app/scene.h"
 #include "core/errors.h"
 #include "core/output.h"
+#include "dem/parallel/band_split.h"
 #include "dem/parallel/solve_across_ranks.h"
 #include "dem/solvers/methods.h"
 
@@ -128,11 +129,14 @@ namespace tribo::app
         scene->attach(*mj);
         if (const unsigned int ranks = rank_count(p.ranks); ranks > 1)
           {
-            mj->use_solver(std::make_unique<dem::parallel::SolveAcrossRanks>(solver, system, p.ranks));
-            log("the contact solve of each step split over " + std::to_string(ranks) +
-                " MPI ranks (horizontal bands, the method's sweeps on each; a deformable first body's "
-                "contacts on the top band's rank); every rank detects and updates the whole system, "
-                "first bodies included, rank 0 writes (docs/scaling.md)");
+            split = std::make_shared<dem::parallel::BandSplit>(p.ranks);
+            mj->use_split(split);
+            mj->use_solver(std::make_unique<dem::parallel::SolveAcrossRanks>(solver, system, split));
+            log("the contacts of each step split over " + std::to_string(ranks) +
+                " MPI ranks (horizontal bands of equal contact counts: each rank detects and solves its "
+                "band's, a deformable first body's on the top band's rank); every rank updates the whole "
+                "system from the contact forces summed over the ranks, first bodies included; rank 0 "
+                "writes (docs/scaling.md)");
           }
         world.integrator = mj.get();
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
@@ -298,13 +302,15 @@ namespace tribo::app
             discs.spin.push_back(b.spin);
             discs.body.push_back(s.discs[d].body);
           }
+        // Each rank's own contacts when it holds its share of them; otherwise those of its
+        // band of discs.
         ContactField contacts;
         for (const auto &c : mj->contacts())
           {
             if (c.r.x() == 0 && c.r.y() == 0)
               continue;
             const auto x0 = s.wrap(s.disc_centre(c.disc[0]));
-            if (!mine(x0.y() + 0.5 * c.branch.y()))
+            if (mj->holds_every_contact() && !mine(x0.y() + 0.5 * c.branch.y()))
               continue;
             contacts.x0.push_back(x0.x());
             contacts.y0.push_back(x0.y());
@@ -365,7 +371,12 @@ namespace tribo::app
         summary.set("max_body_speed", record.max_speed);
         summary.set("n_bodies", long(system.bodies.size()));
         summary.set("n_discs", long(system.discs.size()));
-        summary.set("timing", timing.to_json());
+        {
+          JsonObject t = timing.to_json();
+          if (split)
+            t.set("band_cuts", long(split->cuts())); // since the start or the last resumption
+          summary.set("timing", t);
+        }
         summary.set("setup_time", setup_time);
         summary.set("setup_peak_memory", setup_memory);
         summary.set("peak_memory", peak_memory_mb());
@@ -404,6 +415,7 @@ namespace tribo::app
 
       // After the step number (the driver's): the solver's record, then every object's
       // state, in this order.
+      void prepare_checkpoint() override { mj->gather_warm_start(); }
       void save(CheckpointOut &ar) const override
       {
         record.save(ar);
@@ -428,6 +440,7 @@ namespace tribo::app
       dem::ParticleSystem              system;
       NscdWorld                        world{system}; ///< what the scene's hooks see
       std::unique_ptr<dem::MoreauJean> mj;
+      std::shared_ptr<dem::parallel::BandSplit> split; ///< on N > 1 ranks
       double                           h = 0;
       unsigned long                    n_steps = 0, start = 0, step = 0;
       double                           setup_time = 0, setup_memory = 0;

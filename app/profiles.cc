@@ -125,6 +125,8 @@ namespace tribo::app
               0.5 * (std::pow(v.x() - row[k * n_quantities + q_vx], 2) + std::pow(v.y() - vy_mean[k], 2)) / n;
         }
 
+    // What the contacts add, summed over the MPI ranks when each holds its share of them.
+    std::vector<double> from_contacts(row.size(), 0.0);
     // Love-Weber stresses, spread along the lever arms: each contact adds
     // -f (x) l / A for each free disc it touches (l from the disc centre to the
     // contact point), shared among the layers that l crosses in proportion to the
@@ -144,10 +146,10 @@ namespace tribo::app
               const double b = std::min(hi, k == int(layers) - 1 ? hi : y_l + (k + 1) * thickness);
               w              = std::max(0.0, b - a) / (hi - lo);
             }
-          row[k * n_quantities + q_sxx] += w * c[0];
-          row[k * n_quantities + q_syy] += w * c[1];
-          row[k * n_quantities + q_sxy] += w * c[2];
-          row[k * n_quantities + q_syx] += w * c[3];
+          from_contacts[k * n_quantities + q_sxx] += w * c[0];
+          from_contacts[k * n_quantities + q_syy] += w * c[1];
+          from_contacts[k * n_quantities + q_sxy] += w * c[2];
+          from_contacts[k * n_quantities + q_syx] += w * c[3];
         }
     };
     const auto &contacts = mj.contacts();
@@ -158,7 +160,7 @@ namespace tribo::app
           continue;
         // What the contact dissipates, in the layer of its contact point (from disc 1,
         // which is a disc whatever side 0 is).
-        row[grain_layer(s.disc_centre(c.disc[1]).y() - (s.discs[c.disc[1]].radius + 0.5 * c.gap) * c.normal.y()) *
+        from_contacts[grain_layer(s.disc_centre(c.disc[1]).y() - (s.discs[c.disc[1]].radius + 0.5 * c.gap) * c.normal.y()) *
               n_quantities +
             q_power] -= mj.contact_power()[i];
         const dem::Vec2 t(-c.normal.y(), c.normal.x());
@@ -178,6 +180,9 @@ namespace tribo::app
             spread(yc, yc + l.y(), f, l);
           }
       }
+    mj.sum_over_shares(from_contacts);
+    for (std::size_t j = 0; j < row.size(); ++j)
+      row[j] += from_contacts[j];
     if (block_sum.empty())
       block_sum.assign(row.size(), 0.0);
     for (std::size_t j = 0; j < row.size(); ++j)

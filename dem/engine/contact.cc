@@ -143,7 +143,8 @@ namespace tribo::dem
   } // namespace
 
   void ContactDetector::detect(const ParticleSystem &system, const std::vector<Vec2> &centres, double distance,
-                               unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts)
+                               unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts,
+                               const std::optional<std::pair<double, double>> &midpoints)
   {
     contacts.clear();
     const std::size_t n = centres.size();
@@ -158,21 +159,39 @@ namespace tribo::dem
       2 * system.max_radius() + std::max({distance, closing_reach(system, motion, max_motion_reach), 0.0});
     const CellGrid grid(system, centres, reach);
 
-    // Counting sort of the discs by cell.
+    // A pair is found from the cell of its first disc, whose centre lies within half a
+    // reach of the pair's midpoint; one more cell on each side for the caller's centres.
+    long first_row = 0, end_row = grid.ny;
+    if (midpoints)
+      {
+        const auto row_of = [&](double y) { // the bands' outer edges are infinite
+          const double row = (y - grid.ymin) / grid.wy;
+          return row <= 0 ? 0L : row >= double(grid.ny - 1) ? grid.ny - 1 : long(row);
+        };
+        first_row = row_of(midpoints->first - reach);
+        end_row   = row_of(midpoints->second + reach) + 1;
+      }
+
+    // Counting sort by cell of the discs in the rows searched and their neighbour rows.
+    const long first_cell = std::max(0L, first_row - 1) * grid.nx, end_cell = std::min(grid.ny, end_row + 1) * grid.nx;
+    constexpr unsigned int elsewhere = ~0u;
     cell_start.assign(grid.nx * grid.ny + 1, 0);
     cell_of.resize(n);
     for (std::size_t i = 0; i < n; ++i)
       {
-        cell_of[i] = grid.cell(centres[i]);
-        ++cell_start[cell_of[i] + 1];
+        const long c = grid.cell(centres[i]);
+        cell_of[i]   = c >= first_cell && c < end_cell ? static_cast<unsigned int>(c) : elsewhere;
+        if (cell_of[i] != elsewhere)
+          ++cell_start[c + 1];
       }
     for (long c = 0; c < grid.nx * grid.ny; ++c)
       cell_start[c + 1] += cell_start[c];
-    cell_items.resize(n);
+    cell_items.resize(cell_start.back());
     {
       std::vector<unsigned int> fill(cell_start.begin(), cell_start.end() - 1);
       for (std::size_t i = 0; i < n; ++i)
-        cell_items[fill[cell_of[i]]++] = i;
+        if (cell_of[i] != elsewhere)
+          cell_items[fill[cell_of[i]]++] = i;
     }
 
     // The pairs found in rows [row_begin, row_end) of cells, in the serial order.
@@ -201,10 +220,11 @@ namespace tribo::dem
 
     // Rows of cells in chunks, each chunk's pairs found concurrently and joined in chunk
     // order: the same contacts in the same order as one pass over all rows.
-    const long n_chunks = threads > 1 ? std::min<long>(grid.ny, 4 * long(threads)) : 1;
-    if (n_chunks == 1)
+    const long rows     = end_row - first_row;
+    const long n_chunks = threads > 1 ? std::min<long>(rows, 4 * long(threads)) : 1;
+    if (n_chunks <= 1)
       {
-        detect_rows(0, grid.ny, contacts);
+        detect_rows(first_row, end_row, contacts);
         return;
       }
     chunk_contacts.resize(n_chunks);
@@ -214,7 +234,7 @@ namespace tribo::dem
         for (long k = begin; k < end; ++k)
           {
             chunk_contacts[k].clear();
-            detect_rows(grid.ny * k / n_chunks, grid.ny * (k + 1) / n_chunks, chunk_contacts[k]);
+            detect_rows(first_row + rows * k / n_chunks, first_row + rows * (k + 1) / n_chunks, chunk_contacts[k]);
           }
       },
       1);

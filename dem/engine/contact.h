@@ -6,6 +6,8 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <vector>
 
 namespace tribo::dem
@@ -72,8 +74,14 @@ namespace tribo::dem
     /// as long as the relative motion is at most max_motion_reach largest radii.
     /// Into @p contacts (cleared; its capacity is kept, so that a caller detecting every
     /// step does not allocate and fault in tens of MB of fresh pages each time at 64 000 grains).
+    /// With @p midpoints (lowest, highest; m), only the rows of cells that can hold a pair
+    /// whose midpoint lies between them are searched (a process's band of a case split over
+    /// MPI ranks, dem/engine/contact_split.h): the rows within one cell of that range, so
+    /// that a pair whose midpoint moves by less than a cell between the centres given here
+    /// and the caller's is still found. The caller keeps the pairs it owns.
     void detect(const ParticleSystem &system, const std::vector<Vec2> &centres, double distance,
-                unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts);
+                unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts,
+                const std::optional<std::pair<double, double>> &midpoints = std::nullopt);
     /// The same, returned.
     std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &centres,
                                 double distance, unsigned int threads = 1,

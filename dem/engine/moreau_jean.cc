@@ -80,9 +80,11 @@ namespace tribo::dem
     report.time_solver = seconds_since(phase);
     assess_solve(h, report.solver);
 
-    const double deepest_overlap = measure_gaps(h, report);
     sum_contact_forces(h);
-    const auto fastest = update_bodies(system, h, report);
+    if (own_share)
+      join_shares(h);
+    const double deepest_overlap = measure_gaps(h, report);
+    const auto   fastest         = update_bodies(system, h, report);
     report.max_speed   = fastest.first;
     if (!attached.empty())
       update_boundary_bodies(h, report);
@@ -144,7 +146,26 @@ namespace tribo::dem
         disc_motion[d] = lookahead * h * Vec2(v.x() - v.z() * offset.y(), v.y() + v.z() * offset.x());
       }
     auto                 phase = std::chrono::steady_clock::now();
-    detector.detect(system, centres, distance, solver->parameters().threads, disc_motion, found);
+    const unsigned int   threads = solver->parameters().threads;
+    if (!split)
+      detector.detect(system, centres, distance, threads, disc_motion, found);
+    else
+      {
+        // This process's rows; every pair when the split asks (no share yet, or its bands
+        // must be cut again), and then every process's warm start, whose owners may change.
+        const auto own = split->own_heights();
+        detector.detect(system, centres, distance, threads, disc_motion, found, own);
+        ContactSplit::Share share = split->divide(system, found, !own);
+        const bool          all   = !own || share == ContactSplit::Share::search_all;
+        if (share == ContactSplit::Share::search_all)
+          {
+            detector.detect(system, centres, distance, threads, disc_motion, found);
+            share = split->divide(system, found, true);
+          }
+        if (all)
+          gather_warm_start();
+        own_share = share == ContactSplit::Share::own;
+      }
     report.time_detection      = seconds_since(phase);
 
     // The boundary bodies: free states, predicted nodes, half-disc contacts, each body's
@@ -180,7 +201,8 @@ namespace tribo::dem
             c.node[0] += first;
             c.node[1] += first;
           }
-        found.insert(found.end(), on_boundary.begin(), on_boundary.end());
+        if (!own_share || split->keeps_boundary_contacts())
+          found.insert(found.end(), on_boundary.begin(), on_boundary.end());
       }
   }
 
@@ -220,6 +242,8 @@ namespace tribo::dem
     found.resize(kept);
     current.swap(found);
     report.n_contacts = current.size();
+    if (own_share)
+      return; // the solver adds every process's warm start
     for (const Contact &c : current)
       if (c.r.x() != 0 || c.r.y() != 0)
         state.apply_impulse(c, c.r);
@@ -246,6 +270,18 @@ namespace tribo::dem
         min_gap_end = std::min(min_gap_end, c.gap + th * h * un);
       }
     previous_impulse.assign(next_impulse);
+    if (own_share)
+      {
+        double sums[3] = {double(report.n_active), eps_sum, double(current.size())};
+        double least[2] = {min_gap_end, min_gap_any};
+        split->sum(sums, 3);
+        split->min(least, 2);
+        report.n_active   = static_cast<decltype(report.n_active)>(sums[0]);
+        eps_sum           = sums[1];
+        report.n_contacts = static_cast<decltype(report.n_contacts)>(sums[2]);
+        min_gap_end       = least[0];
+        min_gap_any       = least[1];
+      }
     report.epsilon     = report.n_active ? eps_sum / report.n_active : 0;
     report.max_overlap = std::max(0.0, -min_gap_end);
     const double deepest_overlap = std::max(report.max_overlap, -min_gap_any); // any contact
@@ -274,6 +310,36 @@ namespace tribo::dem
           }
       }
 
+  }
+
+  void MoreauJean::join_shares(double h)
+  {
+    // Eigen's fixed vectors of 3 and 2 doubles lie side by side in a std::vector.
+    split->sum(body_force.front().data(), 3 * body_force.size());
+    if (!node_impulse.empty())
+      split->sum(node_impulse.front().data(), 2 * node_impulse.size());
+    for (std::size_t b = 0; b < body_force.size(); ++b)
+      for (int k = 0; k < 3; ++k)
+        state.velocity[b][k] = v_free[b][k] + h * state.inverse_mass[b][k] * body_force[b][k];
+  }
+
+  void MoreauJean::sum_over_shares(std::vector<double> &values) const
+  {
+    if (own_share)
+      split->sum(values.data(), values.size());
+  }
+
+  void MoreauJean::gather_warm_start()
+  {
+    if (!own_share)
+      return;
+    std::vector<KeyedImpulse> mine;
+    for (const auto &[key, r] : previous_impulse.sorted())
+      mine.push_back({key, {r.x(), r.y()}});
+    std::vector<WarmStart::Entry> every;
+    for (const KeyedImpulse &k : split->all_gathered(mine))
+      every.emplace_back(k.key, Eigen::Vector2d(k.r[0], k.r[1]));
+    previous_impulse.assign(every);
   }
 
   std::pair<double, std::size_t> MoreauJean::update_bodies(ParticleSystem &system, double h, StepReport &report)

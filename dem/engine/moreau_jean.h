@@ -18,6 +18,7 @@
 #include "dem/solvers/apgs.h"
 #include "dem/engine/boundary.h"
 #include "dem/engine/contact.h"
+#include "dem/engine/contact_split.h"
 #include "dem/laws/contact_law.h"
 #include "dem/solvers/interior_point.h"
 #include "dem/solvers/mprgp.h"
@@ -117,6 +118,25 @@ namespace tribo::dem
     /// Solve the steps' contacts with @p other instead of the solver built from the
     /// SolverParameters (a case on several MPI ranks: dem/parallel/solve_across_ranks.h).
     void use_solver(std::unique_ptr<ContactSolver> other) { solver = std::move(other); }
+    /// Divide the steps' contacts with the other processes of @p among (a case on several
+    /// MPI ranks: dem/parallel/band_split.h), each step as among->divide() decides. On a step
+    /// held in shares, this process detects, solves and measures only its own contacts:
+    /// - the solver gets them with the state's free velocities, without their warm-start
+    ///   impulses (it adds every process's: dem/parallel/solve_across_ranks.h);
+    /// - the contact forces on the bodies (and on the boundary bodies' nodes) are summed over
+    ///   the processes, and every body's end velocity v_free + h M^-1 F comes from that sum,
+    ///   so that every process updates every body with the same bits;
+    /// - the StepReport's counts, epsilon and worst overlaps are over every process's contacts;
+    /// - contacts() and contact_power() are this process's share (holds_every_contact()).
+    void use_split(std::shared_ptr<ContactSplit> among) { split = std::move(among); }
+    /// False when the last step's contacts() are this process's share only.
+    bool holds_every_contact() const { return !own_share; }
+    /// Collective on a split: @p values summed over the processes when the last step was
+    /// held in shares (a sum over contacts()); unchanged otherwise.
+    void sum_over_shares(std::vector<double> &values) const;
+    /// Collective on a split: every process's warm-start impulses on every process (before a
+    /// checkpoint, which the first process writes alone).
+    void gather_warm_start();
     /// The attached bodies, in the order of attachment.
     unsigned int n_boundary_bodies() const { return attached.size(); }
 
@@ -169,6 +189,9 @@ namespace tribo::dem
     /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
     /// (returned, m); stores the loaded contacts' impulses as the next warm start.
     double measure_gaps(double h, StepReport &report);
+    /// On a step held in shares: body_force and node_impulse summed over the processes, and
+    /// state's body velocities v_free + h M^-1 F from them.
+    void join_shares(double h);
     /// body_force (and node_impulse, every attached body's nodes) from the contacts' impulses.
     void sum_contact_forces(double h);
     /// End velocities v_free + h M^-1 F_c, positions x_pred + theta h v, powers; returns the
@@ -185,6 +208,8 @@ namespace tribo::dem
     double                   th;
     ContactLaw               contact_law;
     std::unique_ptr<ContactSolver> solver;
+    std::shared_ptr<ContactSplit>  split;
+    bool                           own_share = false; ///< this step's contacts are this process's share
     double                   distance;
     ContactDetector          detector;
     std::vector<Contact>     found;   ///< detect()'s pairs, kept between steps with their capacity

@@ -105,6 +105,15 @@ namespace tribo::dem::parallel
       }
   }
 
+  void DistributedSolver::add_impulses(RankProblem &p, DistributedReport &report)
+  {
+    exchange.remember(p.state);
+    for (const Contact &c : p.contacts)
+      if (c.r.x() != 0 || c.r.y() != 0)
+        p.state.apply_impulse(c, c.r);
+    exchange.exchange(p.state, report);
+  }
+
   bool global_law_residual(const RankProblem &p, const ContactLaw &law, double theta_h, double target,
                            MPI_Comm comm, DistributedReport &report)
   {

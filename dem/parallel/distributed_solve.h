@@ -147,6 +147,10 @@ namespace tribo::dem::parallel
     /// agree with their owners' after the last exchange.
     virtual DistributedReport solve(RankProblem &problem, const ContactLaw &law, const DistributedControls &controls,
                                     double theta_h) = 0;
+    /// Collective: from a state of free velocities on every rank, @p problem's state with
+    /// every rank's contact impulses (a warm start) on it, as solve() wants: each rank puts
+    /// its own contacts' impulses on its bodies, then one exchange.
+    void add_impulses(RankProblem &problem, DistributedReport &report);
 
   protected:
     GrainExchange exchange;

@@ -1,6 +1,7 @@
 #include "dem/parallel/rank_problem.h"
 
 #include <algorithm>
+#include <numeric>
 
 namespace tribo::dem::parallel
 {
@@ -54,85 +55,120 @@ namespace tribo::dem::parallel
     return share_of(system, contacts, contact_heights(system, contacts), state, bands, rank);
   }
 
+  namespace
+  {
+    /// @p p's bodies for its owned contacts, @p contacts[p.serial_contact[k]] (p.contacts
+    /// not filled): the grains' global numbers, the local bodies and their state.
+    void number_bodies(RankProblem &p, const ParticleSystem &system, const std::vector<Contact> &contacts,
+                       const BodyState &state, const BandPartition &bands, unsigned int rank)
+    {
+      const std::size_t       n_bodies = system.bodies.size();
+      const std::vector<bool> grain    = grains_of(system);
+
+      // Global numbers: the grains band by band, each band's in serial order.
+      std::vector<unsigned int> band(n_bodies, 0);
+      std::vector<std::uint64_t> count(bands.n_bands() + 1, 0);
+      for (std::size_t b = 0; b < n_bodies; ++b)
+        if (grain[b])
+          ++count[(band[b] = bands.band_of(system.bodies[b].position.y())) + 1];
+      for (unsigned int k = 0; k < bands.n_bands(); ++k)
+        count[k + 1] += count[k]; // count[k]: the first global number of band k
+      p.n_grains = count[bands.n_bands()];
+      std::vector<std::uint64_t> global(n_bodies, 0);
+      for (std::size_t b = 0; b < n_bodies; ++b)
+        if (grain[b])
+          global[b] = count[band[b]]++;
+
+      // The grains the owned contacts touch.
+      std::vector<bool> touched(n_bodies, false);
+      for (const unsigned int i : p.serial_contact)
+        for (int s = contacts[i].on_boundary() ? 1 : 0; s < 2; ++s)
+          touched[contacts[i].body[s]] = true;
+      std::vector<unsigned int> owned, ghosts, replicated;
+      for (unsigned int b = 0; b < n_bodies; ++b)
+        if (!grain[b])
+          replicated.push_back(b);
+        else if (band[b] == rank)
+          owned.push_back(b);
+        else if (touched[b])
+          ghosts.push_back(b);
+      const auto by_global = [&](unsigned int a, unsigned int b) { return global[a] < global[b]; };
+      std::sort(owned.begin(), owned.end(), by_global);
+      std::sort(ghosts.begin(), ghosts.end(), by_global);
+      p.n_owned = static_cast<unsigned int>(owned.size());
+      p.n_ghost = static_cast<unsigned int>(ghosts.size());
+      for (const auto *list : {&owned, &ghosts, &replicated})
+        p.serial_body.insert(p.serial_body.end(), list->begin(), list->end());
+
+      p.local_body.assign(n_bodies, 0);
+      p.state.velocity.reserve(p.serial_body.size());
+      p.state.inverse_mass.reserve(p.serial_body.size());
+      p.global_grain.reserve(p.n_owned + p.n_ghost);
+      for (unsigned int l = 0; l < p.serial_body.size(); ++l)
+        {
+          const unsigned int b = p.serial_body[l];
+          p.local_body[b]      = l;
+          p.state.velocity.push_back(state.velocity[b]);
+          p.state.inverse_mass.push_back(state.inverse_mass[b]);
+          if (l < p.n_owned + p.n_ghost)
+            p.global_grain.push_back(global[b]);
+        }
+      if (rank == bands.n_bands() - 1)
+        {
+          p.state.node_velocity = state.node_velocity;
+          p.state.node_blocks   = state.node_blocks;
+        }
+    }
+
+    /// @p c's bodies in @p p's local numbers.
+    void to_local(const RankProblem &p, Contact &c)
+    {
+      c.body[1] = p.local_body[c.body[1]];
+      // A half-disc contact's unused side 0 names its grain too: a local body, and no
+      // other rank's.
+      c.body[0] = c.on_boundary() ? c.body[1] : p.local_body[c.body[0]];
+    }
+  } // namespace
+
   RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts,
                        const std::vector<double> &heights, const BodyState &state, const BandPartition &bands,
                        unsigned int rank)
   {
-    const std::size_t       n_bodies = system.bodies.size();
-    const std::vector<bool> grain    = grains_of(system);
-
-    // Global numbers: the grains band by band, each band's in serial order.
-    std::vector<unsigned int> band(n_bodies, 0);
-    std::vector<std::uint64_t> count(bands.n_bands() + 1, 0);
-    for (std::size_t b = 0; b < n_bodies; ++b)
-      if (grain[b])
-        ++count[(band[b] = bands.band_of(system.bodies[b].position.y())) + 1];
-    for (unsigned int k = 0; k < bands.n_bands(); ++k)
-      count[k + 1] += count[k]; // count[k]: the first global number of band k
-    RankProblem p;
-    p.n_grains = count[bands.n_bands()];
-    std::vector<std::uint64_t> global(n_bodies, 0);
-    for (std::size_t b = 0; b < n_bodies; ++b)
-      if (grain[b])
-        global[b] = count[band[b]]++;
-
-    // Owned contacts, and the grains they touch. A half-disc contact belongs to the top
-    // band, whatever its height: a boundary body's contacts are coupled by its compliance,
-    // so one rank holds them all, and its nodes' velocities (side 0; body[0] unused).
+    // Owned contacts. A half-disc contact belongs to the top band, whatever its height: a
+    // boundary body's contacts are coupled by its compliance, so one rank holds them all,
+    // and its nodes' velocities (side 0; body[0] unused).
+    RankProblem        p;
     const unsigned int top = bands.n_bands() - 1;
-    std::vector<bool>  touched(n_bodies, false);
     for (std::size_t i = 0; i < contacts.size(); ++i)
-      {
-        const Contact &c = contacts[i];
-        if ((c.on_boundary() ? top : bands.band_of(heights[i])) != rank)
-          continue;
+      if ((contacts[i].on_boundary() ? top : bands.band_of(heights[i])) == rank)
         p.serial_contact.push_back(static_cast<unsigned int>(i));
-        for (int s = c.on_boundary() ? 1 : 0; s < 2; ++s)
-          touched[c.body[s]] = true;
-      }
-    std::vector<unsigned int> owned, ghosts, replicated;
-    for (unsigned int b = 0; b < n_bodies; ++b)
-      if (!grain[b])
-        replicated.push_back(b);
-      else if (band[b] == rank)
-        owned.push_back(b);
-      else if (touched[b])
-        ghosts.push_back(b);
-    const auto by_global = [&](unsigned int a, unsigned int b) { return global[a] < global[b]; };
-    std::sort(owned.begin(), owned.end(), by_global);
-    std::sort(ghosts.begin(), ghosts.end(), by_global);
-    p.n_owned = static_cast<unsigned int>(owned.size());
-    p.n_ghost = static_cast<unsigned int>(ghosts.size());
-    for (const auto *list : {&owned, &ghosts, &replicated})
-      p.serial_body.insert(p.serial_body.end(), list->begin(), list->end());
-
-    std::vector<unsigned int> local(n_bodies, 0);
-    p.state.velocity.reserve(p.serial_body.size());
-    p.state.inverse_mass.reserve(p.serial_body.size());
-    p.global_grain.reserve(p.n_owned + p.n_ghost);
-    for (unsigned int l = 0; l < p.serial_body.size(); ++l)
-      {
-        const unsigned int b = p.serial_body[l];
-        local[b]             = l;
-        p.state.velocity.push_back(state.velocity[b]);
-        p.state.inverse_mass.push_back(state.inverse_mass[b]);
-        if (l < p.n_owned + p.n_ghost)
-          p.global_grain.push_back(global[b]);
-      }
+    number_bodies(p, system, contacts, state, bands, rank);
     p.contacts.resize(p.serial_contact.size());
     for (std::size_t k = 0; k < p.contacts.size(); ++k)
-      {
-        Contact &c = p.contacts[k] = contacts[p.serial_contact[k]];
-        c.body[1]  = local[c.body[1]];
-        // A half-disc contact's unused side 0 names its grain too: a local body, and no
-        // other rank's.
-        c.body[0] = c.on_boundary() ? c.body[1] : local[c.body[0]];
-      }
-    if (rank == top)
-      {
-        p.state.node_velocity = state.node_velocity;
-        p.state.node_blocks   = state.node_blocks;
-      }
+      to_local(p, p.contacts[k] = contacts[p.serial_contact[k]]);
     return p;
+  }
+
+  RankProblem own_share(const ParticleSystem &system, std::vector<Contact> &contacts, const BodyState &state,
+                        const BandPartition &bands, unsigned int rank)
+  {
+    RankProblem p;
+    p.serial_contact.resize(contacts.size());
+    std::iota(p.serial_contact.begin(), p.serial_contact.end(), 0u);
+    number_bodies(p, system, contacts, state, bands, rank);
+    p.contacts.swap(contacts);
+    for (Contact &c : p.contacts)
+      to_local(p, c);
+    return p;
+  }
+
+  void give_back(RankProblem &p, std::vector<Contact> &contacts)
+  {
+    for (Contact &c : p.contacts)
+      {
+        c.body[1] = p.serial_body[c.body[1]];
+        c.body[0] = p.serial_body[c.body[0]];
+      }
+    contacts.swap(p.contacts);
   }
 } // namespace tribo::dem::parallel

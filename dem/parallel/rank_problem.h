@@ -33,6 +33,8 @@ namespace tribo::dem::parallel
     unsigned int n_owned = 0, n_ghost = 0;
     /// Serial index of each local body and of each owned contact.
     std::vector<unsigned int> serial_body, serial_contact;
+    /// Local number of each serial body that is a local body (undefined for the others).
+    std::vector<unsigned int> local_body;
     /// Global number of each owned and ghost grain (local bodies 0 .. n_owned + n_ghost).
     std::vector<std::uint64_t> global_grain;
     std::uint64_t              n_grains = 0; ///< grains on all ranks
@@ -55,4 +57,12 @@ namespace tribo::dem::parallel
   RankProblem share_of(const ParticleSystem &system, const std::vector<Contact> &contacts,
                        const std::vector<double> &heights, const BodyState &state, const BandPartition &bands,
                        unsigned int rank);
+  /// Rank @p rank's problem of its own @p contacts (all of them in its band: a step held in
+  /// shares, dem/parallel/band_split.h), which it takes over without a copy (@p contacts is
+  /// left empty); give_back() returns them, with their impulses, in serial numbers.
+  RankProblem own_share(const ParticleSystem &system, std::vector<Contact> &contacts, const BodyState &state,
+                        const BandPartition &bands, unsigned int rank);
+  /// @p p's contacts back into @p contacts (the one own_share() emptied), their bodies in
+  /// serial numbers (a half-disc contact's unused side 0 naming its grain).
+  void give_back(RankProblem &p, std::vector<Contact> &contacts);
 } // namespace tribo::dem::parallel

@@ -121,7 +121,7 @@ class Study(WithBaseCase):
         self.assertIn("case 1 (rank 1 and 1 more): running", log)
         for case in ("case_000", "case_001"):
             with open(os.path.join(self.dir, "four", case, "log.txt")) as f:
-                self.assertEqual(f.read().count("the contact solve of each step split over 2 MPI ranks"), 1)
+                self.assertEqual(f.read().count("the contacts of each step split over 2 MPI ranks"), 1)
         # 50 discs: under 64 contacts per rank a step is solved whole on every rank, the serial bits.
         self.assertEqual(table(os.path.join(self.dir, "serial")), table(os.path.join(self.dir, "four")))
         # A study whose cases cannot be split runs one case per rank.

@@ -1,10 +1,11 @@
 // Cell-list detection against brute force, with and without x-periodicity, and the
-// threaded search against the serial one.
+// threaded search against the serial one, and the search of a band of pair midpoints.
 #include "core/errors.h"
 #include "dem/engine/contact.h"
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <set>
 
@@ -42,6 +43,15 @@ namespace
     for (int i = 0; i < 300; ++i)
       s.add_disc({ux(rng), uy(rng)}, ur(rng), 7800);
     return s;
+  }
+
+  /// The discs' centres, wrapped into the period.
+  std::vector<Vec2> wrapped_centres(const ParticleSystem &s)
+  {
+    std::vector<Vec2> x;
+    for (unsigned d = 0; d < s.discs.size(); ++d)
+      x.push_back(s.wrap(s.disc_centre(d)));
+    return x;
   }
 
   /// Cell list against brute force; with @p speed > 0, random disc motions of up to @p speed
@@ -133,12 +143,10 @@ TEST(Detection, AMotionPerDiscIsRequired)
 // contacts in the same order, bit for bit, as the serial pass.
 TEST(Detection, ThreadedSearchIsTheSerialSearch)
 {
-  const ParticleSystem s = random_discs(20e-6);
-  std::vector<Vec2>    x;
-  for (unsigned d = 0; d < s.discs.size(); ++d)
-    x.push_back(s.wrap(s.disc_centre(d)));
-  ContactDetector detector;
-  const auto      serial = detector.detect(s, x, 1e-7, 1);
+  const ParticleSystem    s = random_discs(20e-6);
+  const std::vector<Vec2> x = wrapped_centres(s);
+  ContactDetector         detector;
+  const auto              serial = detector.detect(s, x, 1e-7, 1);
   ASSERT_GT(serial.size(), 100u);
   for (unsigned int threads : {2u, 3u, 8u})
     {
@@ -151,4 +159,38 @@ TEST(Detection, ThreadedSearchIsTheSerialSearch)
           EXPECT_EQ(threaded[k].gap, serial[k].gap);
         }
     }
+}
+
+TEST(Detection, ABandOfMidpointsHoldsEveryPairWhoseMidpointLiesInIt)
+{
+  // The search of a band's rows (a process's share of a case on several MPI ranks) finds
+  // every pair of the whole search whose midpoint lies in the band, with or without threads.
+  const ParticleSystem    s = random_discs(20e-6);
+  const std::vector<Vec2> x = wrapped_centres(s);
+  ContactDetector         detector;
+  const auto              whole = detector.detect(s, x, 1e-7, 1);
+  const double            inf   = std::numeric_limits<double>::infinity();
+  for (const auto &[lo, hi] : {std::pair{-inf, 2e-6}, std::pair{2e-6, 5.5e-6}, std::pair{5.5e-6, inf},
+                               std::pair{3e-6, 3.1e-6}})
+    for (unsigned int threads : {1u, 2u})
+      {
+        std::set<std::pair<unsigned, unsigned>> expected, found;
+        for (const auto &c : whole)
+          if (const double y = 0.5 * (x[c.disc[0]].y() + x[c.disc[1]].y()); y >= lo && y < hi)
+            expected.insert({c.disc[0], c.disc[1]});
+        std::vector<Contact> band;
+        detector.detect(s, x, 1e-7, threads, {}, band, std::make_pair(lo, hi));
+        for (const auto &c : band)
+          if (const double y = 0.5 * (x[c.disc[0]].y() + x[c.disc[1]].y()); y >= lo && y < hi)
+            found.insert({c.disc[0], c.disc[1]});
+        EXPECT_EQ(found, expected) << lo << " to " << hi << ", " << threads << " threads";
+        if (hi - lo > 1e-6)
+          {
+            EXPECT_GT(expected.size(), 30u);
+          }
+        if (lo == -inf || hi == inf) // an edge band's search leaves the far rows out
+          {
+            EXPECT_LT(band.size(), 0.8 * whole.size());
+          }
+      }
 }

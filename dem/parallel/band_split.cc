@@ -1,0 +1,86 @@
+#include "dem/parallel/band_split.h"
+
+#include "dem/parallel/all_gather.h"
+#include "dem/parallel/rank_problem.h"
+
+#include <deal.II/base/mpi.h>
+
+#include <algorithm>
+#include <cstdint>
+
+namespace tribo::dem::parallel
+{
+  BandSplit::BandSplit(MPI_Comm comm, double rebalance_at)
+    : comm(comm)
+    , rank(dealii::Utilities::MPI::this_mpi_process(comm))
+    , ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
+    , rebalance_at(rebalance_at)
+  {}
+
+  std::optional<std::pair<double, double>> BandSplit::own_heights() const
+  {
+    if (!partition)
+      return std::nullopt;
+    return std::make_pair(partition->cut[rank], partition->cut[rank + 1]);
+  }
+
+  ContactSplit::Share BandSplit::divide(const ParticleSystem &system, std::vector<Contact> &pairs, bool all)
+  {
+    const std::vector<double> heights = contact_heights(system, pairs);
+    const auto keep_own = [&]() {
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < pairs.size(); ++i)
+        if (partition->band_of(heights[i]) == rank)
+          pairs[kept++] = pairs[i];
+      pairs.resize(kept);
+      return last = Share::own;
+    };
+    if (!all)
+      {
+        std::uint64_t own = 0;
+        for (const double y : heights)
+          own += partition->band_of(y) == rank;
+        const std::vector<std::uint64_t> counts = dealii::Utilities::MPI::all_gather(comm, own);
+        std::uint64_t total = 0, largest = 0;
+        for (const std::uint64_t c : counts)
+          {
+            total += c;
+            largest = std::max(largest, c);
+          }
+        if (total < std::uint64_t(min_contacts_per_rank) * ranks || double(largest) * ranks > rebalance_at * double(total))
+          {
+            partition.reset();
+            return last = Share::search_all;
+          }
+        return keep_own();
+      }
+    if (pairs.size() < std::size_t(min_contacts_per_rank) * ranks)
+      {
+        partition.reset();
+        return last = Share::whole;
+      }
+    partition = BandPartition::balanced(heights, ranks);
+    ++n_cuts;
+    return keep_own();
+  }
+
+  void BandSplit::sum(double *values, std::size_t n) const
+  {
+    const int count = static_cast<int>(n);
+    if (rank == 0)
+      MPI_Reduce(MPI_IN_PLACE, values, count, MPI_DOUBLE, MPI_SUM, 0, comm);
+    else
+      MPI_Reduce(values, nullptr, count, MPI_DOUBLE, MPI_SUM, 0, comm);
+    MPI_Bcast(values, count, MPI_DOUBLE, 0, comm);
+  }
+
+  void BandSplit::min(double *values, std::size_t n) const
+  {
+    MPI_Allreduce(MPI_IN_PLACE, values, static_cast<int>(n), MPI_DOUBLE, MPI_MIN, comm);
+  }
+
+  std::vector<KeyedImpulse> BandSplit::all_gathered(const std::vector<KeyedImpulse> &mine) const
+  {
+    return parallel::all_gathered(mine, comm);
+  }
+} // namespace tribo::dem::parallel
