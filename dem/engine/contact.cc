@@ -144,7 +144,7 @@ namespace tribo::dem
 
   void ContactDetector::detect(const ParticleSystem &system, const std::vector<Vec2> &centres, double distance,
                                unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts,
-                               const std::optional<std::pair<double, double>> &midpoints)
+                               const std::optional<PairBand> &band)
   {
     contacts.clear();
     const std::size_t n = centres.size();
@@ -160,16 +160,16 @@ namespace tribo::dem
     const CellGrid grid(system, centres, reach);
 
     // A pair is found from the cell of its first disc, whose centre lies within half a
-    // reach of the pair's midpoint; one more cell on each side for the caller's centres.
+    // reach of the pair's midpoint; one more cell on each side for the band's heights.
     long first_row = 0, end_row = grid.ny;
-    if (midpoints)
+    if (band)
       {
         const auto row_of = [&](double y) { // the bands' outer edges are infinite
           const double row = (y - grid.ymin) / grid.wy;
           return row <= 0 ? 0L : row >= double(grid.ny - 1) ? grid.ny - 1 : long(row);
         };
-        first_row = row_of(midpoints->first - reach);
-        end_row   = row_of(midpoints->second + reach) + 1;
+        first_row = row_of(band->lowest - reach);
+        end_row   = row_of(band->highest + reach) + 1;
       }
 
     // Counting sort by cell of the discs in the rows searched and their neighbour rows.
@@ -210,7 +210,7 @@ namespace tribo::dem
                   for (unsigned int b = cell_start[neighbours[k]]; b < cell_start[neighbours[k] + 1]; ++b)
                     {
                       const unsigned int j = cell_items[b];
-                      if (j > i && system.discs[i].body != system.discs[j].body &&
+                      if (j > i && system.discs[i].body != system.discs[j].body && (!band || band->holds(i, j)) &&
                           pair_contact(system, centres, motion, distance, i, j, c))
                         found.push_back(c);
                     }

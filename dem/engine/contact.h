@@ -7,7 +7,6 @@
 
 #include <cstdint>
 #include <optional>
-#include <utility>
 #include <vector>
 
 namespace tribo::dem
@@ -55,6 +54,20 @@ namespace tribo::dem
     }
   };
 
+  /// The pairs whose midpoint lies in [lowest, highest): the mean of the two discs' @p heights
+  /// (m, one per disc).
+  struct PairBand
+  {
+    double                     lowest, highest;
+    const std::vector<double> *heights;
+
+    bool holds(unsigned int i, unsigned int j) const
+    {
+      const double y = 0.5 * ((*heights)[i] + (*heights)[j]);
+      return y >= lowest && y < highest;
+    }
+  };
+
   /// Cell-list detection of disc pairs closer than a detection distance,
   /// linear in the number of discs, with minimum-image pairs across an
   /// x-periodic boundary. Discs of the same body are never paired.
@@ -74,14 +87,14 @@ namespace tribo::dem
     /// as long as the relative motion is at most max_motion_reach largest radii.
     /// Into @p contacts (cleared; its capacity is kept, so that a caller detecting every
     /// step does not allocate and fault in tens of MB of fresh pages each time at 64 000 grains).
-    /// With @p midpoints (lowest, highest; m), only the rows of cells that can hold a pair
-    /// whose midpoint lies between them are searched (a process's band of a case split over
-    /// MPI ranks, dem/engine/contact_split.h): the rows within one cell of that range, so
-    /// that a pair whose midpoint moves by less than a cell between the centres given here
-    /// and the caller's is still found. The caller keeps the pairs it owns.
+    /// With @p band, only the pairs whose midpoint height lies in it (a process's share of a
+    /// case on several MPI ranks, dem/engine/contact_split.h), searched in the rows of cells
+    /// within one cell of the band (at @p centres; the band's heights may be taken elsewhere,
+    /// e.g. at the start of the step: a pair is found unless its discs moved by more than a
+    /// cell in between).
     void detect(const ParticleSystem &system, const std::vector<Vec2> &centres, double distance,
                 unsigned int threads, const std::vector<Vec2> &motion, std::vector<Contact> &contacts,
-                const std::optional<std::pair<double, double>> &midpoints = std::nullopt);
+                const std::optional<PairBand> &band = std::nullopt);
     /// The same, returned.
     std::vector<Contact> detect(const ParticleSystem &system, const std::vector<Vec2> &centres,
                                 double distance, unsigned int threads = 1,

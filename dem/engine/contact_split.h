@@ -13,7 +13,6 @@
 
 #include <cstdint>
 #include <optional>
-#include <utility>
 #include <vector>
 
 namespace tribo::dem
@@ -39,12 +38,12 @@ namespace tribo::dem
       search_all ///< the share could not be kept: detect every pair and divide again
     };
 
-    /// The heights (m, lowest and highest) of the contacts' midpoints this process owns
-    /// this step; nothing: its pairs are not known yet, detect every pair.
-    virtual std::optional<std::pair<double, double>> own_heights() const = 0;
-    /// Collective. @p pairs: the disc pairs detected in the rows of own_heights() (with
-    /// @p all, every pair, the same on every process); keeps this process's share of them
-    /// and says what it did. With Share::search_all, @p pairs is left as it was.
+    /// The pairs this process owns this step, by their midpoints' heights in @p system
+    /// (ContactDetector::detect keeps only those); nothing: not known yet, detect every pair.
+    virtual std::optional<PairBand> own_band(const ParticleSystem &system) = 0;
+    /// Collective. @p pairs: the disc pairs of own_band() (with @p all, every pair, the same
+    /// on every process); keeps this process's share of them and says what it did. With
+    /// Share::search_all, @p pairs is left as it was.
     virtual Share divide(const ParticleSystem &system, std::vector<Contact> &pairs, bool all) = 0;
     /// With Share::own: whether this process keeps the half-disc contacts (one process
     /// holds them all: a deformable body's compliance couples them).

@@ -153,7 +153,7 @@ namespace tribo::dem
       {
         // This process's rows; every pair when the split asks (no share yet, or its bands
         // must be cut again), and then every process's warm start, whose owners may change.
-        const auto own = split->own_heights();
+        const auto own = split->own_band(system);
         detector.detect(system, centres, distance, threads, disc_motion, found, own);
         ContactSplit::Share share = split->divide(system, found, !own);
         const bool          all   = !own || share == ContactSplit::Share::search_all;

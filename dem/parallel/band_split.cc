@@ -17,30 +17,21 @@ namespace tribo::dem::parallel
     , rebalance_at(rebalance_at)
   {}
 
-  std::optional<std::pair<double, double>> BandSplit::own_heights() const
+  std::optional<PairBand> BandSplit::own_band(const ParticleSystem &system)
   {
     if (!partition)
       return std::nullopt;
-    return std::make_pair(partition->cut[rank], partition->cut[rank + 1]);
+    heights = disc_heights(system);
+    return PairBand{partition->cut[rank], partition->cut[rank + 1], &heights};
   }
 
   ContactSplit::Share BandSplit::divide(const ParticleSystem &system, std::vector<Contact> &pairs, bool all)
   {
-    const std::vector<double> heights = contact_heights(system, pairs);
-    const auto keep_own = [&]() {
-      std::size_t kept = 0;
-      for (std::size_t i = 0; i < pairs.size(); ++i)
-        if (partition->band_of(heights[i]) == rank)
-          pairs[kept++] = pairs[i];
-      pairs.resize(kept);
-      return last = Share::own;
-    };
     if (!all)
       {
-        std::uint64_t own = 0;
-        for (const double y : heights)
-          own += partition->band_of(y) == rank;
-        const std::vector<std::uint64_t> counts = dealii::Utilities::MPI::all_gather(comm, own);
+        // The pairs are this rank's already: compare the counts.
+        const std::vector<std::uint64_t> counts =
+          dealii::Utilities::MPI::all_gather(comm, std::uint64_t(pairs.size()));
         std::uint64_t total = 0, largest = 0;
         for (const std::uint64_t c : counts)
           {
@@ -52,16 +43,25 @@ namespace tribo::dem::parallel
             partition.reset();
             return last = Share::search_all;
           }
-        return keep_own();
+        return last = Share::own;
       }
     if (pairs.size() < std::size_t(min_contacts_per_rank) * ranks)
       {
         partition.reset();
         return last = Share::whole;
       }
-    partition = BandPartition::balanced(heights, ranks);
+    heights = disc_heights(system);
+    std::vector<double> y(pairs.size());
+    for (std::size_t i = 0; i < pairs.size(); ++i)
+      y[i] = 0.5 * (heights[pairs[i].disc[0]] + heights[pairs[i].disc[1]]);
+    partition = BandPartition::balanced(y, ranks);
     ++n_cuts;
-    return keep_own();
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < pairs.size(); ++i)
+      if (partition->band_of(y[i]) == rank)
+        pairs[kept++] = pairs[i];
+    pairs.resize(kept);
+    return last = Share::own;
   }
 
   void BandSplit::sum(double *values, std::size_t n) const

@@ -14,8 +14,8 @@ namespace tribo::dem::parallel
   /// Bands of equal contact counts, kept from step to step and cut again when they drift.
   /// A contact belongs to the band of the midpoint of its discs' centres (contact_heights);
   /// a half-disc contact to the top band. Each step:
-  /// - a rank searches only the rows of its band (own_heights()) and keeps the pairs whose
-  ///   midpoint lies in it;
+  /// - a rank searches only the rows of its band and keeps the pairs whose midpoint lies in
+  ///   it (own_band(): the discs' heights, disc_heights());
   /// - the ranks' counts are compared (one MPI_Allgather of a count): when the largest
   ///   exceeds @p rebalance_at times the mean, every rank detects every pair and the bands
   ///   are cut again at the quantiles of the contacts' heights (BandPartition::balanced);
@@ -31,9 +31,8 @@ namespace tribo::dem::parallel
     /// Collective over @p comm; @p rebalance_at > 1.
     explicit BandSplit(MPI_Comm comm, double rebalance_at = 1.05);
 
-    std::optional<std::pair<double, double>> own_heights() const override;
-    Share                                    divide(const ParticleSystem &system, std::vector<Contact> &pairs,
-                                                    bool all) override;
+    std::optional<PairBand> own_band(const ParticleSystem &system) override;
+    Share                   divide(const ParticleSystem &system, std::vector<Contact> &pairs, bool all) override;
     bool keeps_boundary_contacts() const override { return rank + 1 == ranks; }
     void sum(double *values, std::size_t n) const override;
     void min(double *values, std::size_t n) const override;
@@ -52,6 +51,7 @@ namespace tribo::dem::parallel
     unsigned int                 rank, ranks;
     double                       rebalance_at;
     std::optional<BandPartition> partition;
+    std::vector<double>          heights; ///< of the discs at the last own_band() or recut, m
     Share                        last   = Share::whole;
     unsigned long                n_cuts = 0;
   };

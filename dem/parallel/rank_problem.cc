@@ -36,6 +36,14 @@ namespace tribo::dem::parallel
     }
   } // namespace
 
+  std::vector<double> disc_heights(const ParticleSystem &system)
+  {
+    std::vector<double> y(system.discs.size());
+    for (std::size_t d = 0; d < y.size(); ++d)
+      y[d] = disc_height(system, static_cast<unsigned int>(d));
+    return y;
+  }
+
   std::vector<double> contact_heights(const ParticleSystem &system, const std::vector<Contact> &contacts)
   {
     std::vector<double> y(contacts.size());
