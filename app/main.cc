@@ -180,7 +180,7 @@ int main(int argc, char **argv)
         usage_error("'tribo " + args[0] + "' needs a case file");
       if (launched_ranks() > 1 && !o.check_only)
         {
-          // One case on every rank: its contact solve split over them (docs/scaling.md).
+          // One case on every rank: its contacts split over them (docs/scaling.md).
           dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv);
           o.ranks = MPI_COMM_WORLD;
           return tribo::app::run_case(o);

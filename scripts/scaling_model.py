@@ -16,6 +16,15 @@ with w = N / H grains across the period for a layer H grains thick. The sweep's 
 E = T_1 / (P T_P); the solve's is E divided by sweeps(P) / sweeps(1), measured only up to four
 ranks (1.011-1.017 on two, 1.026 on four). A band must be at least two grains high (a contact
 then joins two neighbouring bands at most): P <= H / 2.
+
+A step (docs/scaling.md, "How far this design goes"): the sweeps' share of the one-core step
+split as above, a fraction f of it done whole on every rank (predicting and updating every
+body, every disc's centre and motion), and the contact forces on every body summed over the
+ranks (24 bytes per body, a reduce and a broadcast: 2 ceil(log2 P) (alpha + 24 N / beta)):
+    E_step = 1 / ((1 - f) / E + f P + P t_sum / T_1,step).
+It leaves out what the measured two ranks add beyond the sweep model (waiting for the slower
+rank, each rank's set-up of its share): it gives 0.98 for two ranks here at 16 000 and 64 000
+grains, where they measure 0.82-0.89.
 """
 import math
 
@@ -27,6 +36,10 @@ CHECK_INTERVAL = 10
 HERE = ("this machine (ping-pong, shared memory)", 0.49e-6, 5.5e9)
 NETWORKS = [HERE, ("InfiniBand HDR (typical)", 1.5e-6, 12e9), ("10 Gb Ethernet (typical)", 20e-6, 1.1e9)]
 MEASURED_T2 = {16_000: 0.449e-3, 64_000: 2.05e-3}  # s per sweep on two ranks (warm, 1e-3)
+# A step at 64 000 grains, APGS 1e-3 (docs/scaling.md, "Whole runs", commit 6925331): one core,
+# the mean of two runs, and the part every rank does whole (instrumented once on two ranks).
+STEP_PER_GRAIN = 0.366 / 64_000  # s per grain per step on one core
+WHOLE_FRACTION = 4.0e-3 / 0.366
 
 
 def sweep_time(n, p, thickness, alpha, beta, t_c):
@@ -45,6 +58,15 @@ def efficiency(n, p, thickness, network, t_c):
     return t1 / (p * sweep_time(n, p, thickness, alpha, beta, t_c))
 
 
+def step_efficiency(n, p, thickness, network, t_c):
+    _, alpha, beta = network
+    if p == 1:
+        return 1.0
+    summed = 2 * math.ceil(math.log2(p)) * (alpha + 24 * n / beta)
+    f = WHOLE_FRACTION
+    return 1 / ((1 - f) / efficiency(n, p, thickness, network, t_c) + f * p + p * summed / (STEP_PER_GRAIN * n))
+
+
 def main():
     t_c = T_CONTACT[64_000]
     print("Check against two ranks here (the established code's sample, 46 grains thick, tiled):")
@@ -59,6 +81,15 @@ def main():
     for n in (16_000, 64_000, 1_000_000):
         for network in NETWORKS:
             cells = [f"{efficiency(n, p, 46, network, t_c):.2f}" if p <= 46 // 2 else "bands < 2 grains" for p in ranks]
+            print(f"| {n} | {network[0]} | " + " | ".join(cells) + " |")
+    print()
+    print("Efficiency of a step, the same layers (the part done whole on every rank: f = "
+          f"{WHOLE_FRACTION:.4f} of the one-core step):")
+    print("| grains | network | " + " | ".join(f"P = {p}" for p in ranks if p <= 23) + " |")
+    print("|---|---|" + "---|" * len([p for p in ranks if p <= 23]))
+    for n in (64_000, 1_000_000):
+        for network in NETWORKS[1:]:
+            cells = [f"{step_efficiency(n, p, 46, network, t_c):.2f}" for p in ranks if p <= 23]
             print(f"| {n} | {network[0]} | " + " | ".join(cells) + " |")
     print()
     print("Grains per rank for a sweep's E = 0.8, layers 46 grains thick:")
