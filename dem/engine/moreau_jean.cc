@@ -82,9 +82,9 @@ namespace tribo::dem
 
     sum_contact_forces(h);
     if (own_share)
-      join_shares(h);
-    const double deepest_overlap = measure_gaps(h, report);
+      join_shares();
     const auto   fastest         = update_bodies(system, h, report);
+    const double deepest_overlap = measure_gaps(h, report);
     report.max_speed   = fastest.first;
     if (!attached.empty())
       update_boundary_bodies(h, report);
@@ -312,15 +312,12 @@ namespace tribo::dem
 
   }
 
-  void MoreauJean::join_shares(double h)
+  void MoreauJean::join_shares()
   {
     // Eigen's fixed vectors of 3 and 2 doubles lie side by side in a std::vector.
     split->sum(body_force.front().data(), 3 * body_force.size());
     if (!node_impulse.empty())
       split->sum(node_impulse.front().data(), 2 * node_impulse.size());
-    for (std::size_t b = 0; b < body_force.size(); ++b)
-      for (int k = 0; k < 3; ++k)
-        state.velocity[b][k] = v_free[b][k] + h * state.inverse_mass[b][k] * body_force[b][k];
   }
 
   void MoreauJean::sum_over_shares(std::vector<double> &values) const
@@ -380,6 +377,8 @@ namespace tribo::dem
           }
         report.power_external += body_power[b];
         fastest = std::max(fastest, {v.head<2>().norm(), b});
+        if (own_share) // the solver left only this process's bodies current (measure_gaps)
+          state.velocity[b] = v;
         body.velocity = v.head<2>();
         body.spin     = v.z();
         body.position = x_pred[b] + th * h * body.velocity;

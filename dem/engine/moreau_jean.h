@@ -9,8 +9,8 @@
 /// Imposed-velocity dofs keep their velocity. Impulses are warm-started from
 /// the previous step's contact between the same two discs.
 /// MoreauJean::step() runs these as named phases, in this order: predict(), detect(),
-/// set_up_local_problems(), the contact solve and assess_solve(), measure_gaps(),
-/// sum_contact_forces(), update_bodies(), update_boundary_bodies() (with deformable bodies),
+/// set_up_local_problems(), the contact solve and assess_solve(), sum_contact_forces(),
+/// update_bodies(), measure_gaps(), update_boundary_bodies() (with deformable bodies),
 /// compute_contact_powers(), check_overlaps().
 
 #include "dem/solvers/active_set.h"
@@ -186,17 +186,17 @@ namespace tribo::dem
     /// The local problems of found into current: arms (rows of H), own Delassus blocks,
     /// law terms, free local velocities, warm-start impulses applied to state.
     void set_up_local_problems(const ParticleSystem &system, double h, StepReport &report);
-    /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
-    /// (returned, m); stores the loaded contacts' impulses as the next warm start.
-    double measure_gaps(double h, StepReport &report);
-    /// On a step held in shares: body_force and node_impulse summed over the processes, and
-    /// state's body velocities v_free + h M^-1 F from them.
-    void join_shares(double h);
     /// body_force (and node_impulse, every attached body's nodes) from the contacts' impulses.
     void sum_contact_forces(double h);
+    /// On a step held in shares: body_force and node_impulse summed over the processes
+    /// (update_bodies() then puts every body's end velocity into state too).
+    void join_shares();
     /// End velocities v_free + h M^-1 F_c, positions x_pred + theta h v, powers; returns the
     /// fastest body's speed (m/s) and index. Throws RunError on a non-finite velocity.
     std::pair<double, std::size_t> update_bodies(ParticleSystem &system, double h, StepReport &report);
+    /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
+    /// (returned, m); stores the loaded contacts' impulses as the next warm start.
+    double measure_gaps(double h, StepReport &report);
     /// Each boundary body's update with its node impulses, and their powers and energies.
     void update_boundary_bodies(double h, StepReport &report);
     /// power_of_contact at the mid-step velocities.
