@@ -47,8 +47,10 @@ namespace tribo::dem
   /// W for @p contacts against @p state's inverse masses and boundary compliance, in
   /// compressed-column storage, both triangles, rows and columns in the contacts' order
   /// (the detection's: neighbours in space are neighbours in the matrix). With
-  /// @p low_rank, the returned matrix is W - U U^T, U in low_rank->U.
+  /// @p low_rank, the returned matrix is W - U U^T, U in low_rank->U. Every contact's own
+  /// block is stored (explicit zeros where no body couples). Built column by column, in
+  /// chunks of columns on @p threads threads: the same bits on any number of threads.
   Eigen::SparseMatrix<double> assemble_delassus(const std::vector<Contact> &contacts,
                                                 const BodyState &state, DelassusPart part,
-                                                LowRankBodies *low_rank = nullptr);
+                                                LowRankBodies *low_rank = nullptr, unsigned int threads = 1);
 } // namespace tribo::dem

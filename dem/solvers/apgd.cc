@@ -44,7 +44,7 @@ namespace tribo::dem
   SolveReport ApgdSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
   {
     SolveReport report;
-    const FrictionlessProblem   lcp(contacts, state, true);
+    const FrictionlessProblem   lcp(contacts, state, true, prm.threads);
     const Index                 n = lcp.size();
     FrictionlessProblem::Scaled scaled = lcp.scaled();
     const Eigen::VectorXd      &inv_root = scaled.inv_root;

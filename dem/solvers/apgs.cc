@@ -187,9 +187,12 @@ namespace tribo::dem
       Eigen::Index low_rank_slab = -1;
       for (Eigen::Index k = 0; k < rows && separate; ++k)
         {
-          const Eigen::Index s = slab_of(k / w);
-          for (Eigen::SparseMatrix<double>::InnerIterator a(scaled.A, k); a && separate; ++a)
-            separate = std::abs(slab_of(a.row() / w) - s) <= 1;
+          // A column's rows are sorted: its first and last tell the slabs it reaches.
+          const Eigen::Index s = slab_of(k / w), begin = scaled.A.outerIndexPtr()[k],
+                             end = scaled.A.outerIndexPtr()[k + 1];
+          if (end > begin)
+            separate = std::abs(slab_of(scaled.A.innerIndexPtr()[begin] / w) - s) <= 1 &&
+                       std::abs(slab_of(scaled.A.innerIndexPtr()[end - 1] / w) - s) <= 1;
           if (op.has_low_rank(k))
             {
               separate      = separate && (low_rank_slab < 0 || low_rank_slab == s);
@@ -393,7 +396,7 @@ namespace tribo::dem
   SolveReport ApgsSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law)
   {
     SolveReport        report;
-    const SweepProblem problem(contacts, state, law);
+    const SweepProblem problem(contacts, state, law, prm.threads);
     const Eigen::VectorXd y = ApgsRun(problem, law, prm, step_theta_h, report).solve();
     problem.apply(y, contacts, state);
     return report;

@@ -9,10 +9,10 @@
 namespace tribo::dem
 {
   FrictionlessProblem::FrictionlessProblem(const std::vector<Contact> &contacts,
-                                           const BodyState &state, bool low_rank_bodies)
+                                           const BodyState &state, bool low_rank_bodies, unsigned int threads)
   {
     LowRankBodies low_rank;
-    A = assemble_delassus(contacts, state, DelassusPart::normal, low_rank_bodies ? &low_rank : nullptr);
+    A = assemble_delassus(contacts, state, DelassusPart::normal, low_rank_bodies ? &low_rank : nullptr, threads);
     U = std::move(low_rank.U);
     const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());
     b.resize(n);
@@ -26,13 +26,13 @@ namespace tribo::dem
         b[i]             = c.u_free.x() + c.shift;
         x[i]             = std::max(0.0, c.r.x() + c.cohesion_impulse);
       }
-    b -= product(cohesion);
+    if ((cohesion.array() != 0).any())
+      b -= product(cohesion);
     for (Eigen::Index i = 0; i < n; ++i)
       {
         A.coeffRef(i, i) += contacts[i].compliance;
         diagonal[i] = A.coeff(i, i) + (U.cols() > 0 ? U.row(i).squaredNorm() : 0.0);
       }
-    A.makeCompressed(); // coeffRef inserts a missing diagonal entry uncompressed
     double       loaded_sum = 0;
     unsigned int loaded     = 0;
     for (Eigen::Index i = 0; i < n; ++i)

@@ -32,8 +32,9 @@ namespace tribo::dem
     /// contacts' warm-start impulses c.r; x starts at max(0, r_n + gamma h). With
     /// @p low_rank_bodies, the bodies with many contacts (walls) are kept out of A as the
     /// columns U (dem/linalg/delassus.h): the operator is A + U U^T.
+    /// A is assembled on @p threads threads (the same bits on any number).
     FrictionlessProblem(const std::vector<Contact> &contacts, const BodyState &state,
-                        bool low_rank_bodies = false);
+                        bool low_rank_bodies = false, unsigned int threads = 1);
 
     Eigen::SparseMatrix<double> A;  ///< W_nn + C (- U U^T), both triangles, column-major
     Eigen::MatrixXd             U;  ///< n x k, k = 0 without low_rank_bodies

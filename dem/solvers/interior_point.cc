@@ -110,7 +110,7 @@ namespace tribo::dem
                                        SolveReport &report)
       : prm(prm)
       , report(report)
-      , lcp(contacts, state, true)
+      , lcp(contacts, state, true, prm.threads)
       , n(lcp.size())
       , scaled(lcp.scaled())
       , y(scaled.y)

@@ -51,7 +51,7 @@ namespace tribo::dem
     SolveReport report;
     // The walls (bodies with many contacts) as low-rank terms: A' + U'U'^T, so that a
     // product costs O(nnz(A') + n k) instead of the walls' dense blocks.
-    const FrictionlessProblem lcp(contacts, state, true);
+    const FrictionlessProblem lcp(contacts, state, true, prm.threads);
     const Index               n = lcp.size();
     // The scaled problem (file comment).
     FrictionlessProblem::Scaled       scaled   = lcp.scaled();

@@ -9,13 +9,13 @@
 namespace tribo::dem
 {
   SweepProblem::SweepProblem(const std::vector<Contact> &contacts, const BodyState &state,
-                             const ContactLaw &law)
+                             const ContactLaw &law, unsigned int threads)
     : width(law.friction > 0 ? 2 : 1)
     , friction(law.friction > 0 ? law.friction : 0)
   {
     if (width == 1)
       {
-        const FrictionlessProblem lcp(contacts, state, true);
+        const FrictionlessProblem lcp(contacts, state, true, threads);
         scaled   = lcp.scaled();
         scale    = lcp.scale;
         cohesion = lcp.cohesion;
@@ -23,7 +23,7 @@ namespace tribo::dem
       }
     const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());
     LowRankBodies      low_rank;
-    Eigen::SparseMatrix<double> A = assemble_delassus(contacts, state, DelassusPart::full, &low_rank);
+    Eigen::SparseMatrix<double> A = assemble_delassus(contacts, state, DelassusPart::full, &low_rank, threads);
     const Eigen::MatrixXd      &U = low_rank.U;
     Eigen::VectorXd b(2 * n), x(2 * n), shifted_cohesion = Eigen::VectorXd::Zero(2 * n);
     cohesion.resize(n);
@@ -37,7 +37,8 @@ namespace tribo::dem
         x[2 * i]                = std::max(0.0, c.r.x() + c.cohesion_impulse);
         x[2 * i + 1]            = std::clamp(c.r.y(), -friction * x[2 * i], friction * x[2 * i]);
       }
-    b -= FrictionlessProblem::product_with(A, U, shifted_cohesion);
+    if ((shifted_cohesion.array() != 0).any())
+      b -= FrictionlessProblem::product_with(A, U, shifted_cohesion);
     scaled.inv_root.resize(2 * n);
     double       loaded_sum = 0, free_sum = 0;
     unsigned int loaded     = 0;
@@ -53,7 +54,6 @@ namespace tribo::dem
             ++loaded;
           }
       }
-    A.makeCompressed(); // coeffRef inserts a missing diagonal entry uncompressed
     scale = loaded ? loaded_sum / loaded : n > 0 ? std::max(1e-300, free_sum / n) : 1.0;
 
     const Eigen::VectorXd &s = scaled.inv_root;

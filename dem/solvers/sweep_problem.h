@@ -32,7 +32,9 @@ namespace tribo::dem
   {
     /// The problem of @p contacts against @p state (which holds the contacts' warm-start
     /// impulses c.r), the walls kept as low-rank columns. Width 2 when @p law has friction.
-    SweepProblem(const std::vector<Contact> &contacts, const BodyState &state, const ContactLaw &law);
+    /// The operator is assembled on @p threads threads (the same bits on any number).
+    SweepProblem(const std::vector<Contact> &contacts, const BodyState &state, const ContactLaw &law,
+                 unsigned int threads = 1);
 
     unsigned int width;    ///< rows per contact: 1 (frictionless) or 2 (Coulomb)
     double       friction; ///< mu, 0 without friction

@@ -463,4 +463,7 @@ TEST(HalfDiscs, TheAssembledOperatorCouplesHalfDiscsOnlyThroughTheirOwnBody)
   EXPECT_GE(on[0], 4u);
   EXPECT_GE(on[1], 4u);
   EXPECT_GT(uncoupled_pairs, 0u);
+  // Its columns assembled on two threads: the same matrix, bit for bit.
+  EXPECT_TRUE((Eigen::MatrixXd(assemble_delassus(contacts, state, DelassusPart::full, nullptr, 2)).array() ==
+               W.array()).all());
 }

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -159,6 +161,16 @@ TEST(ContactSolvers, SparseDelassusEqualsTheDenseOperator)
       }
   const Eigen::MatrixXd dense = Eigen::MatrixXd(W);
   EXPECT_LT((dense - exchanged).norm(), 1e-9 * exchanged.norm());
+  // Assembled on two threads: the same entries, bit for bit.
+  for (const DelassusPart part : {DelassusPart::full, DelassusPart::normal})
+    {
+      const Eigen::SparseMatrix<double> one = assemble_delassus(contacts, state, part, nullptr, 1),
+                                        two = assemble_delassus(contacts, state, part, nullptr, 2);
+      ASSERT_EQ(one.nonZeros(), two.nonZeros());
+      EXPECT_TRUE(std::equal(one.valuePtr(), one.valuePtr() + one.nonZeros(), two.valuePtr()));
+      EXPECT_TRUE(std::equal(one.innerIndexPtr(), one.innerIndexPtr() + one.nonZeros(), two.innerIndexPtr()));
+      EXPECT_TRUE(std::equal(one.outerIndexPtr(), one.outerIndexPtr() + one.cols() + 1, two.outerIndexPtr()));
+    }
   EXPECT_LT((dense - dense.transpose()).norm(), 1e-12 * dense.norm());
   for (std::size_t i = 0; i < contacts.size(); ++i)
     {
