@@ -485,7 +485,9 @@ namespace tribo::dem
                   "or the law lets it grow: with IQS, overlaps kept step after step within the "
                   "solver's tolerance (high pressure: tighten "
                << (by_nlgs ? solver_section.entry("Tolerance") + " or " + solver_section.entry("Gap tolerance")
-                           : solver_section.entry("Residual target"))
+                   : solver->parameters().method == SolverParameters::Method::apgs
+                     ? solver_section.entry("Residual target") + " or " + solver_section.entry("Gap tolerance")
+                     : solver_section.entry("Residual target"))
                << ", or set " << contact_law.section.entry("Overlap recovery")
                << "); with ELAS, a stiffness too low for the load (docs/laws.md)";
           }

@@ -320,6 +320,11 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   solver.method = SolverParameters::Method::apgd;
   MoreauJean by_apgd(0.5, law, solver, 1e-8);
   EXPECT_EQ(step_error(by_apgd, placed, 1e-8), placed_overlap("apgd", "Solver/Residual target"));
+  // APGS also reads the gap tolerance (dem/solvers/apgs.h).
+  solver.method = SolverParameters::Method::apgs;
+  MoreauJean by_apgs(0.5, law, solver, 1e-8);
+  EXPECT_EQ(step_error(by_apgs, placed, 1e-8),
+            placed_overlap("apgs", "Solver/Residual target or Solver/Gap tolerance"));
   // Closing at 200 m/s from a gap of 0.1 um in steps of 1e-8 s (2 um per step): the
   // pair is detected and stopped, but the explicit half step (1 - theta) h v carries it
   // 1 um into the overlap.
