@@ -9,12 +9,19 @@
 #include "dem/solvers/nlgs.h"
 #include "tests/unit/lumped_chain.h"
 #include "tests/unit/tall_layer.h"
+#include "core/checkpoint.h"
+
+#include <boost/archive/binary_iarchive.hpp>
+#include <boost/archive/binary_oarchive.hpp>
 
 #include <deal.II/base/mpi.h>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstdio>
 #include <map>
 #include <cmath>
 #include <numeric>
@@ -374,8 +381,8 @@ namespace
   /// detects and solves only its band's contacts, and every rank updates every body from the
   /// contact forces summed over the ranks. Against the serial steps, both solved by APGS to
   /// 1e-10: every contact held by exactly one rank, the same bodies' velocities, the law
-  /// residual over all ranks, the same bits on every rank. Returns how many times the bands
-  /// were cut.
+  /// residual over all ranks, the same bits on every rank, and a checkpoint's warm start
+  /// holding every rank's loaded contacts. Returns how many times the bands were cut.
   unsigned long expect_split_steps_give_the_serial_steps(double rebalance_at)
   {
     const ColdStart  cold;
@@ -443,6 +450,36 @@ namespace
         EXPECT_NEAR(split_system.bodies[b].position.y(), serial.bodies[b].position.y(), 1e-9 * 1e-6 * fastest) << b;
       }
     EXPECT_NEAR(split_report.power_contacts, serial_report.power_contacts, 1e-6 * std::abs(serial_report.power_contacts));
+
+    // A checkpoint's warm start (Simulation::prepare_checkpoint gathers it first): every
+    // rank's loaded contacts once, with their impulses bit for bit, on every rank.
+    std::vector<double> loaded;
+    for (const Contact &c : many.contacts())
+      if (c.r.x() != 0 || c.r.y() != 0)
+        loaded.insert(loaded.end(), {double(c.key()), c.r.x(), c.r.y()});
+    std::vector<std::array<double, 3>> expected;
+    for (const auto &part : dealii::Utilities::MPI::all_gather(world(), loaded))
+      for (std::size_t k = 0; k < part.size(); k += 3)
+        expected.push_back({{part[k], part[k + 1], part[k + 2]}});
+    std::sort(expected.begin(), expected.end());
+    many.gather_warm_start();
+    const std::string path = "split_warm_start." + std::to_string(my_rank()) + ".bin";
+    tribo::write_checkpoint(path, [&](tribo::CheckpointOut &ar) { many.save(ar); });
+    std::vector<std::array<double, 3>> saved;
+    tribo::read_checkpoint(path, [&](tribo::CheckpointIn &ar) {
+      std::size_t n;
+      ar >> n;
+      for (std::size_t k = 0; k < n; ++k)
+        {
+          std::uint64_t key;
+          double        rn, rt;
+          ar >> key >> rn >> rt;
+          saved.push_back({{double(key), rn, rt}});
+        }
+    }, false);
+    std::remove(path.c_str());
+    EXPECT_GT(saved.size(), 100u);
+    EXPECT_EQ(saved, expected);
     return split->cuts();
   }
 } // namespace
