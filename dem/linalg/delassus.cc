@@ -124,7 +124,7 @@ namespace tribo::dem
     };
     const Eigen::Index n_chunks = threads > 1 ? std::min<Eigen::Index>(n, 8 * Eigen::Index(threads)) : 1;
     std::vector<Chunk> chunks(std::max<Eigen::Index>(n_chunks, 1));
-    /// One term of a column: rows width p .. of the block (row-major, width x width).
+    /// One term of contact q's columns: contact `row`'s block W_row,q (row-major, width x width).
     struct Term
     {
       Eigen::Index row;
