@@ -173,7 +173,8 @@ namespace tribo::dem
   private:
     /// The law residual and gap violation of the solve that produced @p report (the residual
     /// too, unless NLGS solved the step; the solve's own when it reports them,
-    /// SolveReport::law_assessed), and the step not converged above SolverParameters::gap_target.
+    /// SolveReport::law_assessed), and the step not converged above SolverParameters::gap_target
+    /// or, solved by a global method, with a law residual above its residual target.
     void assess_solve(double h, SolveReport &report) const;
 
     // The phases of step(), in order (see the file comment).

@@ -862,6 +862,48 @@ TEST(ContactSolvers, AStepAboveTheGapTargetIsNotConverged)
     }
 }
 
+TEST(ContactSolvers, AGlobalMethodsStepAboveItsResidualTargetIsNotConverged)
+{
+  // A global method whose own test says converged (here one that leaves the warm start as
+  // it is) while the law residual of its answer is above its residual target: the step is
+  // reported not converged, with that residual. The same step solved by APGS is converged.
+  class SaysConverged : public ContactSolver
+  {
+  public:
+    using ContactSolver::ContactSolver;
+    SolveReport solve(std::vector<Contact> &, BodyState &, const ContactLaw &, double) override
+    {
+      SolveReport report;
+      report.converged = true;
+      return report;
+    }
+    bool        solves_friction() const override { return true; }
+    std::string random_state() const override { return ""; }
+    void        set_random_state(const std::string &) override {}
+  };
+  SolverParameters apgs;
+  apgs.method          = SolverParameters::Method::apgs;
+  apgs.residual_target = 1e-3;
+  for (const bool solved : {false, true})
+    {
+      ParticleSystem s = hexagonal_stack(100, 0);
+      MoreauJean     mj(0.5, ContactLaw{}, apgs, 0.1 * radius);
+      if (!solved)
+        mj.use_solver(std::make_unique<SaysConverged>(apgs));
+      const StepReport report = mj.step(s, h);
+      ASSERT_GT(report.n_contacts, 10u);
+      EXPECT_EQ(report.solver.converged, solved);
+      if (solved)
+        {
+          EXPECT_LE(report.solver.law_residual, 1e-3);
+        }
+      else
+        {
+          EXPECT_GT(report.solver.law_residual, 1e-2);
+        }
+    }
+}
+
 TEST(ContactSolvers, ApgsWithAGapToleranceKeepsEveryStepsGapBelowIt)
 {
   // The landing of AStepAboveTheGapTargetIsNotConverged, where APGS at a law residual of 1e-3
