@@ -225,7 +225,9 @@ namespace tribo::app
                      << (r.solver.iterations > 0 ? " and " : "");
                 if (r.solver.iterations > 0 || r.solver.factorizations == 0)
                   os << r.solver.iterations << " " << dem::solver_method(method).iterations;
-                if (10 * r.n_active < r.n_contacts)
+                if (r.n_active == 0)
+                  os << "; no contact loaded: the law residual is relative to the contacts' velocity scale";
+                else if (10 * r.n_active < r.n_contacts)
                   os << "; only " << r.n_active << " of the " << r.n_contacts
                      << " contacts loaded: the law residual is relative to their mean impulse";
               }

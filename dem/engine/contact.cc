@@ -15,7 +15,7 @@ namespace tribo::dem
     /// The largest relative motion of two discs: twice the largest distance of a motion from
     /// the middle of their bounding box, at most @p cap largest radii (a few fast discs cannot
     /// widen the cells without bound; pairs further apart are missed as without motions, and
-    /// the overlap guard of the step names the fastest mover), and never so much that a
+    /// the overlap guard of the step names the farthest mover), and never so much that a
     /// period which holds two reaches without motions would not hold two now. 0 without
     /// motions.
     double closing_reach(const ParticleSystem &system, const std::vector<Vec2> &motion, double cap)

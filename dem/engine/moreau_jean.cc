@@ -90,13 +90,12 @@ namespace tribo::dem
     sum_contact_forces(h);
     if (own_share)
       join_shares();
-    const auto   fastest         = update_bodies(system, h, report);
+    report.max_speed             = update_bodies(system, h, report);
     const double deepest_overlap = measure_gaps(h, report);
-    report.max_speed   = fastest.first;
     if (!attached.empty())
       update_boundary_bodies(h, report);
     compute_contact_powers(h);
-    check_overlaps(system, h, report, deepest_overlap, fastest);
+    check_overlaps(system, h, report, deepest_overlap);
     report.kinetic_energy = system.kinetic_energy();
     report.time_step      = seconds_since(step_start);
     return report;
@@ -346,13 +345,13 @@ namespace tribo::dem
     previous_impulse.assign(every);
   }
 
-  std::pair<double, std::size_t> MoreauJean::update_bodies(ParticleSystem &system, double h, StepReport &report)
+  double MoreauJean::update_bodies(ParticleSystem &system, double h, StepReport &report)
   {
     // End velocities and positions, external and contact powers.
     const std::size_t nb = system.bodies.size();
     body_power.assign(nb, 0.0);
     v_mid_of.resize(nb);
-    std::pair<double, std::size_t> fastest{0.0, 0}; // speed (m/s) and body
+    double fastest = 0; // speed of the fastest body, m/s
     for (std::size_t b = 0; b < nb; ++b)
       {
         RigidBody &body = system.bodies[b];
@@ -383,7 +382,7 @@ namespace tribo::dem
               report.power_free += (body_force[b][k] + (body.drive[k] == Drive::force ? body.load[k] : 0)) * v_mid[k];
           }
         report.power_external += body_power[b];
-        fastest = std::max(fastest, {v.head<2>().norm(), b});
+        fastest = std::max(fastest, v.head<2>().norm());
         if (own_share) // the solver left only this process's bodies current (measure_gaps)
           state.velocity[b] = v;
         body.velocity = v.head<2>();
@@ -460,30 +459,42 @@ namespace tribo::dem
   }
 
   void MoreauJean::check_overlaps(const ParticleSystem &system, double h, const StepReport &report,
-                                  double deepest_overlap, const std::pair<double, std::size_t> &fastest) const
+                                  double deepest_overlap) const
   {
     // Two discs overlapping by more than the smallest radius have passed through each
     // other: contacts were missed (something moved too far in one step for the detection
-    // to see it coming) or the solver left them unresolved. Stop, naming the fastest mover.
+    // to see it coming) or the solver left them unresolved. Stop, naming the farthest mover.
     const double r_min = system.discs.empty() ? 0 : system.min_radius();
     if (r_min > 0 && deepest_overlap > r_min)
       {
-        double fastest_node = 0;
-        for (const Vec2 &v : node_v_end)
-          fastest_node = std::max(fastest_node, v.norm());
-        const double speed = std::max(fastest.first, fastest_node);
+        // The farthest mover of the step: x_end - x_begin = h ((1 - theta) v_begin + theta v_end).
+        double      farthest = 0, start_speed = 0, end_speed = 0;
+        std::string mover;
+        const auto  consider = [&](const Vec2 &v0, const Vec2 &v1, const std::string &name) {
+          const double moved = h * ((1 - th) * v0 + th * v1).norm();
+          if (moved > farthest)
+            {
+              farthest    = moved;
+              start_speed = v0.norm();
+              end_speed   = v1.norm();
+              mover       = name;
+            }
+        };
+        for (std::size_t b = 0; b < system.bodies.size(); ++b)
+          consider(v_begin[b].head<2>(), system.bodies[b].velocity, "body " + std::to_string(b));
+        for (std::size_t k = 0; k < node_v_end.size() && k < node_v_begin.size(); ++k)
+          consider(node_v_begin[k], node_v_end[k], "a node of a deformable first body");
         const bool         by_nlgs = report.solver.solved_by_nlgs;
         std::ostringstream os;
         os << "an overlap of " << deepest_overlap << " m, more than the smallest disc radius ("
            << r_min << " m): contacts were missed or left unresolved ("
            << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver->parameters().method) << " "
            << (report.solver.converged ? "converged" : "not converged") << "). ";
-        if (speed * h > 0.25 * r_min)
-          os << "The fastest mover, "
-             << (fastest.first >= fastest_node ? "body " + std::to_string(fastest.second)
-                                               : std::string("a node of a deformable first body"))
-             << ", moved " << speed * h << " m in the step (" << speed << " m/s); a step of at most "
-             << 0.25 * r_min / speed << " s keeps it within a quarter of the smallest radius";
+        if (farthest > 0.25 * r_min)
+          os << "The farthest mover, " << mover << ", moved " << farthest << " m in the step (" << start_speed
+             << " m/s at its start, " << end_speed << " at its end); a step of at most "
+             << 0.25 * r_min / std::max(start_speed, end_speed)
+             << " s keeps it within a quarter of the smallest radius";
         else
           {
             const ParameterSection &solver_section = solver->parameters().section;

@@ -193,8 +193,8 @@ namespace tribo::dem
     /// (update_bodies() then puts every body's end velocity into state too).
     void join_shares();
     /// End velocities v_free + h M^-1 F_c, positions x_pred + theta h v, powers; returns the
-    /// fastest body's speed (m/s) and index. Throws RunError on a non-finite velocity.
-    std::pair<double, std::size_t> update_bodies(ParticleSystem &system, double h, StepReport &report);
+    /// fastest body's speed (m/s). Throws RunError on a non-finite velocity.
+    double update_bodies(ParticleSystem &system, double h, StepReport &report);
     /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
     /// (returned, m); stores the loaded contacts' impulses as the next warm start.
     double measure_gaps(double h, StepReport &report);
@@ -202,9 +202,11 @@ namespace tribo::dem
     void update_boundary_bodies(double h, StepReport &report);
     /// power_of_contact at the mid-step velocities.
     void compute_contact_powers(double h);
-    /// RunError when an overlap exceeds the smallest radius, naming the likely cause.
-    void check_overlaps(const ParticleSystem &system, double h, const StepReport &report, double deepest_overlap,
-                        const std::pair<double, std::size_t> &fastest) const;
+    /// RunError when an overlap exceeds the smallest radius, naming the likely cause: the
+    /// body (or boundary node) that moved farthest in the step, h |(1 - theta) v_begin +
+    /// theta v_end|, when that is more than a quarter of the smallest radius.
+    void check_overlaps(const ParticleSystem &system, double h, const StepReport &report,
+                        double deepest_overlap) const;
 
     double                   th;
     ContactLaw               contact_law;

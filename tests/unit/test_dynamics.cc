@@ -332,9 +332,9 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   MoreauJean     mj2(0.5, ContactLaw{}, tight(), 1e-6);
   EXPECT_EQ(step_error(mj2, fast, 1e-8),
             "an overlap of 9e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
-            "missed or left unresolved (nlgs converged). The fastest mover, body 1, moved 1e-06 m "
-            "in the step (100 m/s); a step of at most 1.5e-09 s keeps it within a quarter of the "
-            "smallest radius");
+            "missed or left unresolved (nlgs converged). The farthest mover, body 1, moved 1.5e-06 m "
+            "in the step (200 m/s at its start, 100 at its end); a step of at most 7.5e-10 s keeps it "
+            "within a quarter of the smallest radius");
   // At 20 m/s the same pair ends each step with an overlap of at most (1 - theta) h v.
   ParticleSystem slow = pair_at(2 * r + 1e-7, -20);
   MoreauJean     mj3(0.5, ContactLaw{}, tight(), 1e-6);
