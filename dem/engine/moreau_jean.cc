@@ -458,15 +458,68 @@ namespace tribo::dem
 
   }
 
+  MoreauJean::DeepestContact MoreauJean::deepest_contact(const ParticleSystem &system, double h) const
+  {
+    // Normal velocity of c, side 1 relative to side 0, at body velocities v_begin (weight
+    // 1 - theta) and v_end (theta): its end-of-step gap minus its gap at the step's start is h
+    // times it, since x_end - x_begin = h ((1 - theta) v_begin + theta v_end).
+    const auto closing_rate = [&](const Contact &c) {
+      double u = 0;
+      for (int side = 0; side < 2; ++side)
+        {
+          const double sign = side == 0 ? -1.0 : 1.0;
+          if (side == 0 && c.on_boundary())
+            {
+              Vec2 v_point = Vec2::Zero();
+              for (int k = 0; k < 2; ++k)
+                v_point += c.node_map[k] * ((1 - th) * node_v_begin[c.node[k]] + th * node_v_end[c.node[k]]);
+              u -= c.normal.dot(v_point);
+              continue;
+            }
+          const RigidBody       &body = system.bodies[c.body[side]];
+          const Eigen::Vector3d  v    = (1 - th) * v_begin[c.body[side]] +
+                                    th * Eigen::Vector3d(body.velocity.x(), body.velocity.y(), body.spin);
+          u += sign * (c.normal.dot(v.head<2>()) + c.arm_n[side] * v.z());
+        }
+      return u;
+    };
+    DeepestContact deepest;
+    double         least_gap = INFINITY;
+    for (const Contact &c : current)
+      if (const double end_gap = c.gap + th * h * state.local_velocity(c).x(); end_gap < least_gap)
+        {
+          least_gap        = end_gap;
+          deepest.overlap  = -end_gap;
+          deepest.closed   = std::max(0.0, -h * closing_rate(c));
+          deepest.bodies   = {c.on_boundary() ? -1.0 : double(c.body[0]), double(c.body[1])};
+        }
+    if (own_share)
+      {
+        // Another process may hold it: the values of the deepest over every process (each
+        // contact is held once; a process whose deepest is shallower offers +inf).
+        double least[1] = {least_gap};
+        split->min(least, 1);
+        double held[3] = {INFINITY, INFINITY, INFINITY};
+        if (least_gap == least[0])
+          held[0] = deepest.closed, held[1] = deepest.bodies[0], held[2] = deepest.bodies[1];
+        split->min(held, 3);
+        deepest = {-least[0], held[0], {held[1], held[2]}};
+      }
+    return deepest;
+  }
+
   void MoreauJean::check_overlaps(const ParticleSystem &system, double h, const StepReport &report,
                                   double deepest_overlap) const
   {
     // Two discs overlapping by more than the smallest radius have passed through each
     // other: contacts were missed (something moved too far in one step for the detection
-    // to see it coming) or the solver left them unresolved. Stop, naming the farthest mover.
+    // to see it coming), the solver left them unresolved, or an overlap grew over many steps.
+    // Stop, naming the deepest contact's history in the step, and the farthest mover when
+    // the step made most of the overlap.
     const double r_min = system.discs.empty() ? 0 : system.min_radius();
     if (r_min > 0 && deepest_overlap > r_min)
       {
+        const DeepestContact deepest = deepest_contact(system, h);
         // The farthest mover of the step: x_end - x_begin = h ((1 - theta) v_begin + theta v_end).
         double      farthest = 0, start_speed = 0, end_speed = 0;
         std::string mover;
@@ -490,7 +543,7 @@ namespace tribo::dem
            << r_min << " m): contacts were missed or left unresolved ("
            << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver->parameters().method) << " "
            << (report.solver.converged ? "converged" : "not converged") << "). ";
-        if (farthest > 0.25 * r_min)
+        if (deepest.closed > 0.5 * deepest.overlap)
           os << "The farthest mover, " << mover << ", moved " << farthest << " m in the step (" << start_speed
              << " m/s at its start, " << end_speed << " at its end); a step of at most "
              << 0.25 * r_min / std::max(start_speed, end_speed)
@@ -498,9 +551,13 @@ namespace tribo::dem
         else
           {
             const ParameterSection &solver_section = solver->parameters().section;
-            os << "No body moved more than a quarter of the smallest radius in the step: the "
-                  "overlap does not come from the step size. Either discs were placed overlapping, "
-                  "or the law lets it grow: with IQS, overlaps kept step after step within the "
+            os << "The deepest contact, between "
+               << (deepest.bodies[0] < 0 ? std::string("a half-disc of a deformable first body")
+                                         : "body " + std::to_string(long(deepest.bodies[0])))
+               << " and body " << long(deepest.bodies[1]) << ", overlapped by "
+               << deepest.overlap - deepest.closed << " m at the step's start and closed by " << deepest.closed
+               << " m in the step: the overlap does not come from the step size. Either discs were placed "
+                  "overlapping, or the law lets it grow: with IQS, overlaps kept step after step within the "
                   "solver's tolerance (high pressure: tighten "
                << (by_nlgs ? solver_section.entry("Tolerance") + " or " + solver_section.entry("Gap tolerance")
                    : solver->parameters().method == SolverParameters::Method::apgs

@@ -307,8 +307,9 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   // The message for a step solved by @p method, whose accuracy entries are @p advice.
   auto placed_overlap = [](const std::string &method, const std::string &advice) {
     return "an overlap of 7e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
-           "missed or left unresolved (" + method + " converged). No body moved more than a quarter of "
-           "the smallest radius in the step: the overlap does not come from the step size. "
+           "missed or left unresolved (" + method + " converged). The deepest contact, between body 0 "
+           "and body 1, overlapped by 7e-07 m at the step's start and closed by 0 m in the step: the "
+           "overlap does not come from the step size. "
            "Either discs were placed overlapping, or the law lets it grow: with IQS, overlaps "
            "kept step after step within the solver's tolerance (high pressure: tighten " + advice +
            ", or set Contact law/Overlap recovery); with ELAS, a stiffness too low for the load "
@@ -335,6 +336,16 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
             "missed or left unresolved (nlgs converged). The farthest mover, body 1, moved 1.5e-06 m "
             "in the step (200 m/s at its start, 100 at its end); a step of at most 7.5e-10 s keeps it "
             "within a quarter of the smallest radius");
+  // Overlapping by 0.95 r and closing at 12 m/s: the explicit half step carries the pair 0.1 r
+  // deeper, IQS stops it there. The step made 0.1 r of the 1.05 r: the message names the
+  // contact's overlap at the step's start, not a step size (which would not have helped).
+  ParticleSystem deep = pair_at(2 * r - 0.95 * r, -12);
+  MoreauJean     mj4(0.5, ContactLaw{}, tight(), 1e-6);
+  const std::string deep_error = step_error(mj4, deep, 1e-8);
+  EXPECT_EQ(deep_error.substr(0, deep_error.find(": the overlap does not come")),
+            "an overlap of 6.3e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
+            "missed or left unresolved (nlgs converged). The deepest contact, between body 0 and "
+            "body 1, overlapped by 5.7e-07 m at the step's start and closed by 6e-08 m in the step");
   // At 20 m/s the same pair ends each step with an overlap of at most (1 - theta) h v.
   ParticleSystem slow = pair_at(2 * r + 1e-7, -20);
   MoreauJean     mj3(0.5, ContactLaw{}, tight(), 1e-6);
