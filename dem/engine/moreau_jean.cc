@@ -460,38 +460,40 @@ namespace tribo::dem
 
   MoreauJean::DeepestContact MoreauJean::deepest_contact(const ParticleSystem &system, double h) const
   {
-    // Normal velocity of c, side 1 relative to side 0, at body velocities v_begin (weight
-    // 1 - theta) and v_end (theta): its end-of-step gap minus its gap at the step's start is h
-    // times it, since x_end - x_begin = h ((1 - theta) v_begin + theta v_end).
-    const auto closing_rate = [&](const Contact &c) {
-      double u = 0;
-      for (int side = 0; side < 2; ++side)
+    // A side's velocity (vx, vy, spin) at weight w between v_begin (0) and v_end (1); a
+    // half-disc side moves as its material point, J_A v_A + J_B v_B (no spin).
+    const auto side_velocity = [&](const Contact &c, int side, double w) -> Eigen::Vector3d {
+      if (side == 0 && c.on_boundary())
         {
-          const double sign = side == 0 ? -1.0 : 1.0;
-          if (side == 0 && c.on_boundary())
-            {
-              Vec2 v_point = Vec2::Zero();
-              for (int k = 0; k < 2; ++k)
-                v_point += c.node_map[k] * ((1 - th) * node_v_begin[c.node[k]] + th * node_v_end[c.node[k]]);
-              u -= c.normal.dot(v_point);
-              continue;
-            }
-          const RigidBody       &body = system.bodies[c.body[side]];
-          const Eigen::Vector3d  v    = (1 - th) * v_begin[c.body[side]] +
-                                    th * Eigen::Vector3d(body.velocity.x(), body.velocity.y(), body.spin);
-          u += sign * (c.normal.dot(v.head<2>()) + c.arm_n[side] * v.z());
+          Vec2 v = Vec2::Zero();
+          for (int k = 0; k < 2; ++k)
+            v += c.node_map[k] * ((1 - w) * node_v_begin[c.node[k]] + w * node_v_end[c.node[k]]);
+          return {v.x(), v.y(), 0};
         }
-      return u;
+      const RigidBody &body = system.bodies[c.body[side]];
+      return (1 - w) * v_begin[c.body[side]] + w * Eigen::Vector3d(body.velocity.x(), body.velocity.y(), body.spin);
     };
     DeepestContact deepest;
     double         least_gap = INFINITY;
     for (const Contact &c : current)
       if (const double end_gap = c.gap + th * h * state.local_velocity(c).x(); end_gap < least_gap)
         {
-          least_gap        = end_gap;
-          deepest.overlap  = -end_gap;
-          deepest.closed   = std::max(0.0, -h * closing_rate(c));
-          deepest.bodies   = {c.on_boundary() ? -1.0 : double(c.body[0]), double(c.body[1])};
+          // Each side moves h ((1 - theta) v_begin + theta v_end) in the step; along the normal
+          // (side 1 relative to side 0, the arms turning the spins into the contact point's
+          // motion) that is how far the step closed the contact.
+          least_gap = end_gap;
+          double rate = 0;
+          deepest.moved = 0;
+          for (int side = 0; side < 2; ++side)
+            {
+              const Eigen::Vector3d v = side_velocity(c, side, th);
+              const bool            half_disc = side == 0 && c.on_boundary();
+              rate += (side == 0 ? -1.0 : 1.0) * (c.normal.dot(v.head<2>()) + (half_disc ? 0.0 : c.arm_n[side] * v.z()));
+              deepest.moved = std::max(deepest.moved, h * v.head<2>().norm());
+            }
+          deepest.overlap = -end_gap;
+          deepest.closed  = std::max(0.0, -h * rate);
+          deepest.bodies  = {{c.on_boundary() ? -1.0 : double(c.body[0]), double(c.body[1])}};
         }
     if (own_share)
       {
@@ -499,11 +501,11 @@ namespace tribo::dem
         // contact is held once; a process whose deepest is shallower offers +inf).
         double least[1] = {least_gap};
         split->min(least, 1);
-        double held[3] = {INFINITY, INFINITY, INFINITY};
+        double held[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
         if (least_gap == least[0])
-          held[0] = deepest.closed, held[1] = deepest.bodies[0], held[2] = deepest.bodies[1];
-        split->min(held, 3);
-        deepest = {-least[0], held[0], {held[1], held[2]}};
+          held[0] = deepest.closed, held[1] = deepest.moved, held[2] = deepest.bodies[0], held[3] = deepest.bodies[1];
+        split->min(held, 4);
+        deepest = {-least[0], held[0], held[1], {{held[2], held[3]}}};
       }
     return deepest;
   }
@@ -514,8 +516,8 @@ namespace tribo::dem
     // Two discs overlapping by more than the smallest radius have passed through each
     // other: contacts were missed (something moved too far in one step for the detection
     // to see it coming), the solver left them unresolved, or an overlap grew over many steps.
-    // Stop, naming the deepest contact's history in the step, and the farthest mover when
-    // the step made most of the overlap.
+    // Stop, naming the farthest mover when a body of the deepest contact moved more than a
+    // quarter of the smallest radius in the step, else that contact's overlap at the start.
     const double r_min = system.discs.empty() ? 0 : system.min_radius();
     if (r_min > 0 && deepest_overlap > r_min)
       {
@@ -543,7 +545,7 @@ namespace tribo::dem
            << r_min << " m): contacts were missed or left unresolved ("
            << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver->parameters().method) << " "
            << (report.solver.converged ? "converged" : "not converged") << "). ";
-        if (deepest.closed > 0.5 * deepest.overlap)
+        if (deepest.moved > 0.25 * r_min)
           os << "The farthest mover, " << mover << ", moved " << farthest << " m in the step (" << start_speed
              << " m/s at its start, " << end_speed << " at its end); a step of at most "
              << 0.25 * r_min / std::max(start_speed, end_speed)

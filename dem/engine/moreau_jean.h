@@ -206,20 +206,23 @@ namespace tribo::dem
     void compute_contact_powers(double h);
     /// The contact with the deepest end-of-step overlap (over every process on a step held
     /// in shares; collective there): its overlap (m), how far the step closed it, h times
-    /// its normal closing velocity at (1 - theta) v_begin + theta v_end (m, >= 0), and its
-    /// bodies (side 0 -1 for a half-disc), as doubles for the reduction.
+    /// its normal closing velocity at (1 - theta) v_begin + theta v_end (m, >= 0), the
+    /// farther move of its two sides in the step, h |(1 - theta) v_begin + theta v_end| (m),
+    /// and its bodies (side 0 -1 for a half-disc), as doubles for the reduction.
     struct DeepestContact
     {
-      double                overlap = 0, closed = 0;
+      double                overlap = 0, closed = 0, moved = 0;
       std::array<double, 2> bodies{{-1, -1}};
     };
     DeepestContact deepest_contact(const ParticleSystem &system, double h) const;
-    /// RunError when an overlap exceeds the smallest radius, naming the likely cause. When
-    /// the step closed the deepest contact by more than half its overlap: the body (or
-    /// boundary node) that moved farthest in the step, h |(1 - theta) v_begin + theta v_end|,
-    /// and the step that keeps it within a quarter of the smallest radius. Otherwise the
-    /// overlap was there at the step's start (placed, or grown over steps within the
-    /// solver's tolerance): that contact's overlap then and the entries that limit its growth.
+    /// RunError when an overlap exceeds the smallest radius, naming the likely cause. When a
+    /// side of the deepest contact moved more than a quarter of the smallest radius in the
+    /// step (the motion, not the contact's history, made the overlap, and the contact's
+    /// linearised geometry may not hold): the body (or boundary node) that moved farthest,
+    /// h |(1 - theta) v_begin + theta v_end|, and the step that keeps it within a quarter of
+    /// the smallest radius. Otherwise the overlap was there at the step's start (placed, or
+    /// grown over steps within the solver's tolerance): that contact's overlap then, what
+    /// the step added, and the entries that limit its growth.
     /// Collective on a step held in shares (every process throws the same message).
     void check_overlaps(const ParticleSystem &system, double h, const StepReport &report,
                         double deepest_overlap) const;

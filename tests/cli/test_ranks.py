@@ -26,6 +26,7 @@ Usage: /usr/bin/python3 test_ranks.py /path/to/tribo
 import csv
 import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -228,6 +229,31 @@ class Ranks(TempDirTestCase):
             self.assertEqual(rows[:len(kept)], kept, "%s rewrote the rows before the checkpoint" % out)
             self.assertEqual(int(float(rows[-1][1])), steps)
             self.assertFalse(os.path.exists(os.path.join(self.tmp, out, "checkpoint.bin")))
+
+    def test_an_overlap_grown_over_steps_stops_one_and_two_ranks_naming_its_contact(self):
+        # At 1e10 Pa (100 times the paper's) IQS keeps the overlaps that each step's solve leaves
+        # within its tolerance: one grows to the smallest radius. The stop names the deepest
+        # contact wherever its rank; its overlap at the step's start is the one the previous
+        # step ended with (statistics.csv, every step), and the step added little to it.
+        args = ["--quiet", "--set", "Shear cell/Pressure=1e10", "--set", "Simulation/End time=6e-6",
+                "--set", "Output/Statistics interval=1"]
+        pattern = (r"an overlap of (\S+) m, more than the smallest disc radius \((\S+) m\).*The deepest contact, "
+                   r"between body (\d+) and body (\d+), overlapped by (\S+) m at the step's start and closed by "
+                   r"(\S+) m in the step: the overlap does not come from the step size")
+        for ranks in (1, 2):
+            out = "r%d" % ranks
+            r = self.run_ranks(ranks, ["run", "case.prm", "--output", out] + args)
+            self.assertEqual(r.returncode, 1, r.stderr)
+            found = re.search(pattern, r.stderr)
+            self.assertIsNotNone(found, r.stderr)
+            overlap, r_min, _, _, start, closed = (float(found.group(k)) for k in range(1, 7))
+            rows = statistics(os.path.join(self.tmp, out))
+            previous = float(rows[-1][rows[0].index("max_overlap")])
+            self.assertGreater(overlap, r_min)
+            self.assertAlmostEqual(start + closed, overlap, delta=1e-5 * r_min)
+            self.assertLess(closed, 0.25 * r_min)
+            self.assertGreater(start, 0.9 * r_min)
+            self.assertLessEqual(start, previous * (1 + 1e-4), (ranks, start, previous))
 
     def test_nlgs_on_two_ranks_stops_by_its_own_norm(self):
         # 1000 steps of the compaction: NLGS (Quad 1e-4) on two ranks against one.
