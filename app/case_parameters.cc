@@ -29,6 +29,12 @@ namespace tribo::app
     prm.declare_entry("End time", "1e-6", Double(), "Simulated time, s (> 0).");
     prm.declare_entry("Theta", "0.5", Double(0.5, 1.0),
                       "Moreau-Jean theta, in [0.5, 1]: 0.5 is the midpoint rule, 1 is implicit Euler.");
+    prm.declare_entry("Most substeps", "1", Integer(1),
+                      "Disc scenes with rigid first bodies: a step whose fastest body would move more than a "
+                      "quarter of the smallest radius at its speed at the step's start is taken as k equal "
+                      "sub-steps, k = ceil(h v_max / (r_min / 4)), at most this many (>= 1; 1: never). A grain "
+                      "a solve launched is then stopped by its neighbours before the explicit half step "
+                      "carries it into them (docs/laws.md).");
     prm.leave_subsection();
 
     prm.enter_subsection("Contact law");
@@ -64,6 +70,7 @@ namespace tribo::app
     p.time_step = f.get_checked("Simulation/Time step", is_positive, "a positive time step in s");
     p.end_time  = f.get_checked("Simulation/End time", is_positive, "a positive end time in s");
     p.theta     = f.get_double("Simulation/Theta");
+    p.most_substeps = f.get_integer("Simulation/Most substeps");
 
     p.law    = dem::ContactLaw::parse(f, "Contact law");
     p.solver = dem::SolverParameters::parse(f, "Solver");

@@ -22,6 +22,7 @@ namespace tribo::app
     double      time_step;
     double      end_time;
     double      theta;
+    unsigned int most_substeps; ///< Simulation/Most substeps (dem::MoreauJean::allow_substeps)
     dem::ContactLaw     law;
     dem::SolverParameters solver;
     unsigned int statistics_interval; ///< steps between rows of statistics.csv

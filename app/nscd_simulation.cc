@@ -127,6 +127,10 @@ namespace tribo::app
         solver.gap_target            = p.solver.relative_gap_target * system.min_radius();
         mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
         scene->attach(*mj);
+        mj->allow_substeps(p.most_substeps);
+        if (p.most_substeps > 1 && mj->n_boundary_bodies() > 0)
+          log("Simulation/Most substeps = " + std::to_string(p.most_substeps) +
+              " has no effect on this case: its deformable first body's integrator keeps the step");
         if (const unsigned int ranks = rank_count(p.ranks); ranks > 1)
           {
             split = std::make_shared<dem::parallel::BandSplit>(p.ranks);
@@ -196,6 +200,15 @@ namespace tribo::app
         scene->after_step(world);
         record.add(r);
         timing.add(r);
+        if (r.substeps > 1 && ++substepped <= 10)
+          {
+            std::ostringstream os;
+            os << "note: step " << step << " (t = " << time() << " s) taken in " << r.substeps
+               << " sub-steps (Simulation/Most substeps): a body's speed at its start would have carried it "
+                  "more than a quarter of the smallest radius"
+               << (substepped == 10 ? " (further ones only counted)" : "");
+            warn(os.str());
+          }
         if (!r.solver.converged && ++record.non_converged <= 10)
           {
             // Which solve stopped short: NLGS (the method, the frictional steps it is handed,
@@ -321,8 +334,8 @@ namespace tribo::app
             contacts.y0.push_back(x0.y());
             contacts.x1.push_back(x0.x() + c.branch.x());
             contacts.y1.push_back(x0.y() + c.branch.y());
-            contacts.normal_force.push_back(c.r.x() / h);
-            contacts.tangential_force.push_back(c.r.y() / h);
+            contacts.normal_force.push_back(c.r.x() / mj->step_length()); // over the last (sub-)step
+            contacts.tangential_force.push_back(c.r.y() / mj->step_length());
             contacts.gap.push_back(c.gap);
           }
         writer.write(time(), discs, contacts, {rank, ranks});
@@ -408,6 +421,8 @@ namespace tribo::app
           os << ", " << record.fallbacks << " NLGS fallbacks";
         if (record.gap_exceeded > 0)
           os << ", " << record.gap_exceeded << " steps above Solver/Gap target";
+        if (substepped > 0)
+          os << ", " << substepped << " steps in sub-steps since the run's start or resumption";
         if (timing.steps > 0)
           {
             const double n = timing.steps;
@@ -450,6 +465,7 @@ namespace tribo::app
       unsigned long                    n_steps = 0, start = 0, step = 0;
       double                           setup_time = 0, setup_memory = 0;
       SolverRecord                     record;
+      unsigned long                    substepped = 0; ///< steps taken in sub-steps since this process started
       StepTiming                       timing; ///< the steps since the start or the last resumption
       Row                              last;   ///< the columns measured after the last step
       bool                             measured = false;

@@ -69,8 +69,7 @@ namespace tribo::app
     , target(layer_target)
   {}
 
-  void LayerProfiles::accumulate(const dem::ParticleSystem &s, const dem::MoreauJean &mj, double h,
-                                 double upper_surface)
+  void LayerProfiles::accumulate(const dem::ParticleSystem &s, const dem::MoreauJean &mj, double upper_surface)
   {
     const double y_l = s.bodies[lower].position.y() + inset, y_u = upper_surface;
     const double H   = y_u - y_l;
@@ -164,7 +163,7 @@ namespace tribo::app
               n_quantities +
             q_power] -= mj.contact_power()[i];
         const dem::Vec2 t(-c.normal.y(), c.normal.x());
-        const dem::Vec2 f1 = (c.r.x() * c.normal + c.r.y() * t) / h; // on disc 1
+        const dem::Vec2 f1 = (c.r.x() * c.normal + c.r.y() * t) / mj.step_length(); // on disc 1, over the last (sub-)step
         // Lever arms from each disc centre to the contact point (middle of the gap).
         const dem::Vec2 l0 = (s.discs[c.disc[0]].radius + 0.5 * c.gap) * c.normal;
         const dem::Vec2 l1 = -(s.discs[c.disc[1]].radius + 0.5 * c.gap) * c.normal;

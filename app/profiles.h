@@ -50,10 +50,10 @@ namespace tribo::app
     LayerProfiles(unsigned int lower, unsigned int upper, double wall_inset, double layer_target);
     static constexpr unsigned int no_body = ~0u;
 
-    /// Add the state after a step of length @p h to the current block, with the upper
-    /// first body's surface at height @p upper_surface (m).
-    void accumulate(const dem::ParticleSystem &system, const dem::MoreauJean &mj, double h,
-                    double upper_surface);
+    /// Add the state after a step of @p mj to the current block (its contacts' forces are
+    /// their impulses over MoreauJean::step_length()), with the upper first body's surface at
+    /// height @p upper_surface (m).
+    void accumulate(const dem::ParticleSystem &system, const dem::MoreauJean &mj, double upper_surface);
     /// Close the current block as one sample, at time @p t_begin (s: the beginning of its
     /// first step); nothing without accumulated steps.
     void end_block(double t_begin);

@@ -347,7 +347,7 @@ namespace tribo::app
             if (block_steps == 0)
               block_steps = std::max(1UL, (n_steps - std::min(n_steps - 1, first) + k.profile_samples - 1) /
                                             k.profile_samples);
-            profiles->accumulate(s, mj, h, ub.surface);
+            profiles->accumulate(s, mj, ub.surface);
             const unsigned long done = steps_done - std::min(steps_done, first); // shearing steps so far
             if (done % block_steps == 0 || steps_done >= n_steps)
               profiles->end_block((steps_done - profiles->n_open_steps()) * h);

@@ -74,9 +74,84 @@ namespace tribo::dem
       report.residual = accuracy.relative;
   }
 
+  unsigned int MoreauJean::substeps_needed(const ParticleSystem &system, double h) const
+  {
+    if (most_substeps <= 1 || !attached.empty() || system.discs.empty())
+      return 1;
+    double fastest = 0;
+    for (const RigidBody &body : system.bodies)
+      fastest = std::max(fastest, body.velocity.norm());
+    const double quarter = 0.25 * system.min_radius();
+    return static_cast<unsigned int>(std::clamp(std::ceil(h * fastest / quarter), 1.0, double(most_substeps)));
+  }
+
   StepReport MoreauJean::step(ParticleSystem &system, double h)
   {
+    const unsigned int k = substeps_needed(system, h);
+    if (k == 1)
+      return single_step(system, h);
+    const auto                   step_start = std::chrono::steady_clock::now();
+    StepReport                   total;
+    std::vector<Eigen::Vector3d> force_sum;
+    std::vector<double>          power_sum;
+    for (unsigned int i = 0; i < k; ++i)
+      {
+        const StepReport r = single_step(system, h / k);
+        if (i == 0)
+          {
+            total = r;
+            force_sum.assign(body_force.size(), Eigen::Vector3d::Zero());
+            power_sum.assign(body_power.size(), 0.0);
+          }
+        else
+          {
+            SolveReport &s = total.solver;
+            s.iterations += r.solver.iterations;
+            s.factorizations += r.solver.factorizations;
+            s.check_passes += r.solver.check_passes;
+            s.time_exchange += r.solver.time_exchange;
+            s.converged      = s.converged && r.solver.converged;
+            s.fell_back      = s.fell_back || r.solver.fell_back;
+            s.solved_by_nlgs = s.solved_by_nlgs || r.solver.solved_by_nlgs;
+            s.gap_exceeded   = s.gap_exceeded || r.solver.gap_exceeded;
+            s.concurrent     = s.concurrent && r.solver.concurrent;
+            s.law_residual   = std::max(s.law_residual, r.solver.law_residual);
+            s.residual       = std::max(s.residual, r.solver.residual);
+            s.gap_violation  = std::max(s.gap_violation, r.solver.gap_violation);
+            total.max_overlap = std::max(total.max_overlap, r.max_overlap);
+            total.max_speed   = std::max(total.max_speed, r.max_speed);
+            for (double StepReport::*sum : {&StepReport::power_external, &StepReport::power_free,
+                                            &StepReport::power_contacts, &StepReport::boundary_dissipation,
+                                            &StepReport::time_detection, &StepReport::time_boundary_body,
+                                            &StepReport::time_solver})
+              total.*sum += r.*sum;
+            total.n_contacts          = r.n_contacts;
+            total.n_active            = r.n_active;
+            total.epsilon             = r.epsilon;
+            total.kinetic_energy      = r.kinetic_energy;
+            total.boundary_energy     = r.boundary_energy;
+            total.n_boundary_contacts = r.n_boundary_contacts;
+          }
+        for (std::size_t b = 0; b < body_force.size(); ++b)
+          force_sum[b] += body_force[b] / k;
+        for (std::size_t b = 0; b < body_power.size(); ++b)
+          power_sum[b] += body_power[b] / k;
+      }
+    // Forces and powers over the step: the means over its sub-steps.
+    for (double StepReport::*mean : {&StepReport::power_external, &StepReport::power_free,
+                                     &StepReport::power_contacts, &StepReport::boundary_dissipation})
+      total.*mean /= k;
+    body_force.swap(force_sum);
+    body_power.swap(power_sum);
+    total.substeps  = k;
+    total.time_step = seconds_since(step_start);
+    return total;
+  }
+
+  StepReport MoreauJean::single_step(ParticleSystem &system, double h)
+  {
     const auto step_start = std::chrono::steady_clock::now();
+    last_step_length      = h;
     StepReport report;
     predict(system, h);
     detect(system, h, report);

@@ -63,6 +63,11 @@ namespace tribo::dem
     double boundary_energy      = 0;
     double boundary_dissipation = 0;
     unsigned int n_boundary_contacts = 0; ///< contacts with half-disc elements, every body's
+    /// The step was taken as this many equal sub-steps (MoreauJean::allow_substeps()): its
+    /// counts and the solve's figures are the sums (iterations, factorisations, times) or the
+    /// worst (residuals, overlaps, speeds) over them, its powers their means (so that h times
+    /// a power is the step's energy), epsilon, contacts and the end state the last one's.
+    unsigned int substeps = 1;
     /// Wall time of the step and of its phases, s: detection (disc pairs and half-discs),
     /// the boundary bodies' own work (their free state in predict() and their update in
     /// finalize()), and the NLGS solve; the rest is setting up the local problems and
@@ -142,8 +147,19 @@ namespace tribo::dem
     /// The attached bodies, in the order of attachment.
     unsigned int n_boundary_bodies() const { return attached.size(); }
 
-    /// Advance @p system (and the attached boundary bodies) by one step @p h (s).
+    /// Advance @p system (and the attached boundary bodies) by one step @p h (s), in
+    /// sub-steps where allow_substeps() lets it.
     StepReport step(ParticleSystem &system, double h);
+    /// Take a step as k equal sub-steps, k <= @p most, when its fastest body would move
+    /// farther than a quarter of the smallest radius at its speed at the step's start:
+    /// k = ceil(h |v|_max / (r_min / 4)). The explicit half step (1 - theta) h v moves a body
+    /// before the solve can stop it, and a grain the solve launched would otherwise be carried
+    /// into its neighbours (the overlap stop's farthest mover). 1 (the default): never.
+    /// Not with attached boundary bodies, whose own integrators keep their step.
+    void allow_substeps(unsigned int most) { most_substeps = std::max(1U, most); }
+    /// The length of the last step or, when it was taken in sub-steps, of its last sub-step
+    /// (s): contacts() hold impulses over it, so a contact's force is r / step_length().
+    double step_length() const { return last_step_length; }
 
     /// Contacts of the last step with their impulses (N s/m).
     const std::vector<Contact> &contacts() const { return current; }
@@ -173,6 +189,10 @@ namespace tribo::dem
     void load(CheckpointIn &ar);
 
   private:
+    /// One step of @p h without sub-steps: the phases below, in order.
+    StepReport single_step(ParticleSystem &system, double h);
+    /// The sub-steps of a step @p h (allow_substeps()).
+    unsigned int substeps_needed(const ParticleSystem &system, double h) const;
     /// The law residual and gap violation of the solve that produced @p report (the residual
     /// too, unless NLGS solved the step; the solve's own when it reports them,
     /// SolveReport::law_assessed), and the step not converged above SolverParameters::gap_target
@@ -233,6 +253,8 @@ namespace tribo::dem
     std::shared_ptr<ContactSplit>  split;
     bool                           own_share = false; ///< this step's contacts are this process's share
     double                   distance;
+    unsigned int             most_substeps    = 1;
+    double                   last_step_length = 0;
     ContactDetector          detector;
     std::vector<Contact>     found;   ///< detect()'s pairs, kept between steps with their capacity
     std::vector<Contact>     current;

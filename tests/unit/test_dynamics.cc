@@ -346,6 +346,27 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
             "an overlap of 6.3e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
             "missed or left unresolved (nlgs converged). The deepest contact, between body 0 and "
             "body 1, overlapped by 5.7e-07 m at the step's start and closed by 6e-08 m in the step");
+  // With sub-steps allowed, the same step is taken as ceil(h v / (r / 4)) = 14 sub-steps of
+  // h / 14: the pair meets within one of them and IQS stops it there (a perfectly inelastic
+  // impact: both discs at -100 m/s). The merged report and forces describe the whole step:
+  // its energy book closes with the powers' means, and each disc's contact force times h is
+  // its change of momentum.
+  ParticleSystem substepped = pair_at(2 * r + 1e-7, -200);
+  MoreauJean     mj5(0.5, ContactLaw{}, tight(), 1e-6);
+  mj5.allow_substeps(16);
+  const double     mass = substepped.bodies[1].mass, energy_before = substepped.kinetic_energy();
+  const StepReport report = mj5.step(substepped, 1e-8);
+  EXPECT_EQ(report.substeps, 14u);
+  EXPECT_NEAR(mj5.step_length(), 1e-8 / 14, 1e-24);
+  EXPECT_NEAR(substepped.bodies[0].velocity.x(), -100, 1e-9);
+  EXPECT_NEAR(substepped.bodies[1].velocity.x(), -100, 1e-9);
+  EXPECT_LT(report.max_overlap, 0.25 * r);
+  EXPECT_NEAR(substepped.kinetic_energy() - energy_before, 1e-8 * (report.power_external + report.power_contacts),
+              1e-9 * energy_before);
+  EXPECT_LT(report.power_contacts, 0); // the impact dissipates half the kinetic energy
+  EXPECT_NEAR(1e-8 * report.power_contacts, -0.5 * energy_before, 1e-9 * energy_before);
+  EXPECT_NEAR(mj5.contact_force()[1].x() * 1e-8, mass * 100, 1e-9 * mass * 100);
+  EXPECT_NEAR(mj5.contact_force()[0].x() * 1e-8, -mass * 100, 1e-9 * mass * 100);
   // At 20 m/s the same pair ends each step with an overlap of at most (1 - theta) h v.
   ParticleSystem slow = pair_at(2 * r + 1e-7, -20);
   MoreauJean     mj3(0.5, ContactLaw{}, tight(), 1e-6);

@@ -101,7 +101,8 @@ TEST(ResumeChanges, TheLoadingMayNotChange)
   Case c("subsection Shear cell\n  set Pressure = 2e8\nend\n");
   EXPECT_EQ(message(saved, c),
             "--resume out: entry 'Shear cell/Pressure' is '2e8' in the case but '1e8' in the "
-            "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time and "
+            "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time, "
+            "Simulation/Most substeps and "
             "Shear cell/Upper body prediction depth");
 }
 
@@ -118,6 +119,7 @@ TEST(ResumeChanges, AnEntryNewerThanTheCheckpointIsRefusedWhenTheCaseSetsIt)
   Case c("subsection Shear cell\n  set New entry = 0.7\nend\n");
   EXPECT_EQ(message(saved, c),
             "--resume out: entry 'Shear cell/New entry' is '0.7' in the case but '(absent)' in the "
-            "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time and "
+            "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time, "
+            "Simulation/Most substeps and "
             "Shear cell/Upper body prediction depth");
 }
