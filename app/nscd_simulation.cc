@@ -127,7 +127,7 @@ namespace tribo::app
         solver.gap_target            = p.solver.relative_gap_target * system.min_radius();
         mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
         scene->attach(*mj);
-        mj->allow_substeps(p.most_substeps);
+        mj->allow_substeps(p.most_substeps, "Simulation/Most substeps");
         if (p.most_substeps > 1 && mj->n_boundary_bodies() > 0)
           log("Simulation/Most substeps = " + std::to_string(p.most_substeps) +
               " has no effect on this case: its deformable first body's integrator keeps the step");

@@ -624,7 +624,10 @@ namespace tribo::dem
           os << "The farthest mover, " << mover << ", moved " << farthest << " m in the step (" << start_speed
              << " m/s at its start, " << end_speed << " at its end); a step of at most "
              << 0.25 * r_min / std::max(start_speed, end_speed)
-             << " s keeps it within a quarter of the smallest radius";
+             << " s keeps it within a quarter of the smallest radius"
+             << (substeps_entry.empty() || !attached.empty() ? ""
+                 : most_substeps == 1 ? " (or set " + substeps_entry + " > 1 to take such steps in sub-steps)"
+                                      : " (or raise " + substeps_entry + ")");
         else
           {
             const ParameterSection &solver_section = solver->parameters().section;

@@ -31,6 +31,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -155,8 +156,13 @@ namespace tribo::dem
     /// k = ceil(h |v|_max / (r_min / 4)). The explicit half step (1 - theta) h v moves a body
     /// before the solve can stop it, and a grain the solve launched would otherwise be carried
     /// into its neighbours (the overlap stop's farthest mover). 1 (the default): never.
-    /// Not with attached boundary bodies, whose own integrators keep their step.
-    void allow_substeps(unsigned int most) { most_substeps = std::max(1U, most); }
+    /// Not with attached boundary bodies, whose own integrators keep their step. @p entry:
+    /// the case's entry that sets @p most, which the overlap stop names as a remedy ("": none).
+    void allow_substeps(unsigned int most, const std::string &entry = "")
+    {
+      most_substeps  = std::max(1U, most);
+      substeps_entry = entry;
+    }
     /// The length of the last step or, when it was taken in sub-steps, of its last sub-step
     /// (s): contacts() hold impulses over it, so a contact's force is r / step_length().
     double step_length() const { return last_step_length; }
@@ -254,6 +260,7 @@ namespace tribo::dem
     bool                           own_share = false; ///< this step's contacts are this process's share
     double                   distance;
     unsigned int             most_substeps    = 1;
+    std::string              substeps_entry; ///< allow_substeps()'s entry
     double                   last_step_length = 0;
     ContactDetector          detector;
     std::vector<Contact>     found;   ///< detect()'s pairs, kept between steps with their capacity

@@ -269,6 +269,9 @@ class WallThroughLayer(unittest.TestCase):
             self.assertLessEqual(moved, 2e-7 * max(start, end) * (1 + 1e-5))
             self.assertGreater(moved, 0)
             self.assertLess(step, 2e-7)
+            # ... or sub-steps where they are needed.
+            self.assertIn(" s keeps it within a quarter of the smallest radius (or set Simulation/Most substeps > 1 "
+                          "to take such steps in sub-steps)", summary["error"])
 
 
 if __name__ == "__main__":
