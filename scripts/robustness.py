@@ -54,6 +54,7 @@ MATRIX = [
     ("time step", "h = 2e-10", SHEAR, {"Simulation/Time step": "2e-10", "Simulation/End time": "4e-6",
                                        "Shear cell/Shear start": "2e-6"}),
     ("time step", "h = 2e-8", SHEAR, {"Simulation/Time step": "2e-8"}),
+    ("time step", "h = 2e-8, Most substeps 16", SHEAR, {"Simulation/Time step": "2e-8", "Simulation/Most substeps": "16"}),
     ("time step", "h = 2e-7", SHEAR, {"Simulation/Time step": "2e-7", "Simulation/End time": "2e-5",
                                       "Shear cell/Shear start": "1e-5"}),
     ("time step", "mlp body, h = 2e-9 (c_p h / s = 3.9)", SHEAR,
