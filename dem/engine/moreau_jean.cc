@@ -535,18 +535,18 @@ namespace tribo::dem
 
   MoreauJean::DeepestContact MoreauJean::deepest_contact(const ParticleSystem &system, double h) const
   {
-    // A side's velocity (vx, vy, spin) at weight w between v_begin (0) and v_end (1); a
-    // half-disc side moves as its material point, J_A v_A + J_B v_B (no spin).
-    const auto side_velocity = [&](const Contact &c, int side, double w) -> Eigen::Vector3d {
+    // A side's step velocity (vx, vy, spin), (1 - theta) v_begin + theta v_end; a half-disc
+    // side moves as its material point, J_A v_A + J_B v_B (no spin).
+    const auto side_velocity = [&](const Contact &c, int side) -> Eigen::Vector3d {
       if (side == 0 && c.on_boundary())
         {
           Vec2 v = Vec2::Zero();
           for (int k = 0; k < 2; ++k)
-            v += c.node_map[k] * ((1 - w) * node_v_begin[c.node[k]] + w * node_v_end[c.node[k]]);
+            v += c.node_map[k] * ((1 - th) * node_v_begin[c.node[k]] + th * node_v_end[c.node[k]]);
           return {v.x(), v.y(), 0};
         }
       const RigidBody &body = system.bodies[c.body[side]];
-      return (1 - w) * v_begin[c.body[side]] + w * Eigen::Vector3d(body.velocity.x(), body.velocity.y(), body.spin);
+      return (1 - th) * v_begin[c.body[side]] + th * Eigen::Vector3d(body.velocity.x(), body.velocity.y(), body.spin);
     };
     DeepestContact deepest;
     double         least_gap = INFINITY;
@@ -561,7 +561,7 @@ namespace tribo::dem
           deepest.moved = 0;
           for (int side = 0; side < 2; ++side)
             {
-              const Eigen::Vector3d v = side_velocity(c, side, th);
+              const Eigen::Vector3d v = side_velocity(c, side);
               const bool            half_disc = side == 0 && c.on_boundary();
               rate += (side == 0 ? -1.0 : 1.0) * (c.normal.dot(v.head<2>()) + (half_disc ? 0.0 : c.arm_n[side] * v.z()));
               deepest.moved = std::max(deepest.moved, h * v.head<2>().norm());
