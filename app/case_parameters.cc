@@ -35,6 +35,12 @@ namespace tribo::app
                       "sub-steps, k = ceil(h v_max / (r_min / 4)), at most this many (>= 1; 1: never). A grain "
                       "a solve launched is then stopped by its neighbours before the explicit half step "
                       "carries it into them (docs/laws.md).");
+    prm.declare_entry("Most substeps on retake", "64", Integer(1),
+                      "Disc scenes with rigid first bodies: a step whose motion carried a body into another past "
+                      "the smallest radius, or a disc farther than contact detection foresaw, is taken again from "
+                      "its start as k equal sub-steps, k = ceil(h v / (r_min / 4)) with v that body's larger "
+                      "speed, at most this many (>= 1; 1: never, the run stops at such an overlap). Only such "
+                      "steps pay (docs/laws.md).");
     prm.leave_subsection();
 
     prm.enter_subsection("Contact law");
@@ -71,6 +77,7 @@ namespace tribo::app
     p.end_time  = f.get_checked("Simulation/End time", is_positive, "a positive end time in s");
     p.theta     = f.get_double("Simulation/Theta");
     p.most_substeps = f.get_integer("Simulation/Most substeps");
+    p.most_retake_substeps = f.get_integer("Simulation/Most substeps on retake");
 
     p.law    = dem::ContactLaw::parse(f, "Contact law");
     p.solver = dem::SolverParameters::parse(f, "Solver");

@@ -23,6 +23,7 @@ namespace tribo::app
     double      end_time;
     double      theta;
     unsigned int most_substeps; ///< Simulation/Most substeps (dem::MoreauJean::allow_substeps)
+    unsigned int most_retake_substeps; ///< Simulation/Most substeps on retake (dem::MoreauJean::allow_retakes)
     dem::ContactLaw     law;
     dem::SolverParameters solver;
     unsigned int statistics_interval; ///< steps between rows of statistics.csv

@@ -26,8 +26,9 @@ Usage:
       (Solver/Method = apgs or nlgs); rank 0 writes (docs/scaling.md).
   tribo run CASE.prm --resume DIR [--set ...] [--quiet]
       Continue the run in DIR from its checkpoint.bin (Output/Checkpoint interval); only
-      Solver/*, Output/*, Simulation/End time, Simulation/Most substeps and Shear cell/Upper
-      body prediction depth may differ from the checkpointed run.
+      Solver/*, Output/*, Simulation/End time, Simulation/Most substeps, Simulation/Most
+      substeps on retake and Shear cell/Upper body prediction depth may differ from the
+      checkpointed run.
   tribo check CASE.prm [--set ...]
       Read and validate a case without running it.
   tribo study STUDY.prm [--output DIR] [--quiet]

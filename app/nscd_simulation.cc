@@ -128,6 +128,7 @@ namespace tribo::app
         mj = std::make_unique<dem::MoreauJean>(p.theta, p.law, solver, distance);
         scene->attach(*mj);
         mj->allow_substeps(p.most_substeps, "Simulation/Most substeps");
+        mj->allow_retakes(p.most_retake_substeps, "Simulation/Most substeps on retake");
         if (p.most_substeps > 1 && mj->n_boundary_bodies() > 0)
           log("Simulation/Most substeps = " + std::to_string(p.most_substeps) +
               " has no effect on this case: its deformable first body's integrator keeps the step");
@@ -200,7 +201,14 @@ namespace tribo::app
         scene->after_step(world);
         record.add(r);
         timing.add(r);
-        if (r.substeps > 1 && ++substepped <= 10)
+        if (r.retaken)
+          {
+            if (++retaken <= 10)
+              warn("note: step " + std::to_string(step) + " (t = " + to_text(time()) + " s) taken again in " +
+                   std::to_string(r.substeps) + " sub-steps (Simulation/Most substeps on retake): " +
+                   mj->retake_reason() + (retaken == 10 ? " (further ones only counted)" : ""));
+          }
+        else if (r.substeps > 1 && ++substepped <= 10)
           {
             std::ostringstream os;
             os << "note: step " << step << " (t = " << time() << " s) taken in " << r.substeps
@@ -423,6 +431,8 @@ namespace tribo::app
           os << ", " << record.gap_exceeded << " steps above Solver/Gap target";
         if (substepped > 0)
           os << ", " << substepped << " steps in sub-steps since the run's start or resumption";
+        if (retaken > 0)
+          os << ", " << retaken << " steps taken again in sub-steps since the run's start or resumption";
         if (timing.steps > 0)
           {
             const double n = timing.steps;
@@ -466,6 +476,7 @@ namespace tribo::app
       double                           setup_time = 0, setup_memory = 0;
       SolverRecord                     record;
       unsigned long                    substepped = 0; ///< steps taken in sub-steps since this process started
+      unsigned long                    retaken = 0; ///< steps taken again in sub-steps since this process started
       StepTiming                       timing; ///< the steps since the start or the last resumption
       Row                              last;   ///< the columns measured after the last step
       bool                             measured = false;

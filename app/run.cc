@@ -43,7 +43,7 @@ namespace tribo::app
     /// "Solver/*, Output/*, Simulation/End time and ..." for the refusal's message.
     std::string changeable_entries()
     {
-      std::string text = "Solver/*, Output/*, Simulation/End time, Simulation/Most substeps";
+      std::string text = "Solver/*, Output/*, Simulation/End time, Simulation/Most substeps, Simulation/Most substeps on retake";
       const auto  first_body = first_body_entries_that_may_change();
       for (std::size_t i = 0; i < first_body.size(); ++i)
         text += (i + 1 == first_body.size() ? " and " : ", ") + first_body[i];
@@ -55,7 +55,7 @@ namespace tribo::app
   {
     const auto first_body = first_body_entries_that_may_change();
     return entry.rfind("Solver/", 0) == 0 || entry.rfind("Output/", 0) == 0 || entry == "Simulation/End time" ||
-           entry == "Simulation/Most substeps" ||
+           entry == "Simulation/Most substeps" || entry == "Simulation/Most substeps on retake" ||
            std::find(first_body.begin(), first_body.end(), entry) != first_body.end();
   }
 

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace tribo::dem
@@ -36,6 +37,21 @@ namespace tribo::dem
 
   namespace
   {
+    /// A step too long for its motion (MoreauJean::allow_retakes()): check_overlaps()'s stop
+    /// when the step's motion made the overlap, or check_foresight()'s; the mover's larger
+    /// speed (m/s) and a short account for the log of a step taken again.
+    class StepTooLong : public RunError
+    {
+    public:
+      StepTooLong(const std::string &message, double fastest, std::string why)
+        : RunError(message)
+        , speed(fastest)
+        , reason(std::move(why))
+      {}
+      double      speed;
+      std::string reason;
+    };
+
     /// Seconds since @p start.
     double seconds_since(const std::chrono::steady_clock::time_point &start)
     {
@@ -88,6 +104,105 @@ namespace tribo::dem
   StepReport MoreauJean::step(ParticleSystem &system, double h)
   {
     const unsigned int k = substeps_needed(system, h);
+    if (most_retake_substeps <= 1 || !attached.empty() || system.discs.empty())
+      return in_substeps(system, h, k);
+    // Keep what a retake needs: the bodies' state (a few doubles each) and, when the step is
+    // taken in sub-steps (each of which replaces it), the warm start; a single step replaces
+    // the warm start only once it has passed its checks.
+    const auto step_start = std::chrono::steady_clock::now();
+    at_start.resize(system.bodies.size());
+    for (std::size_t b = 0; b < system.bodies.size(); ++b)
+      {
+        const RigidBody &body = system.bodies[b];
+        at_start[b]           = {body.position, body.velocity, body.angle, body.spin};
+      }
+    std::optional<WarmStart> impulse_at_start;
+    if (k > 1)
+      impulse_at_start = previous_impulse;
+    // Each attempt that a StepTooLong stops is followed by one in more sub-steps, from the
+    // step's start, until one passes or the most sub-steps allowed have failed.
+    for (unsigned int substeps = k;;)
+      try
+        {
+          attempt_substeps  = substeps;
+          StepReport report = in_substeps(system, h, substeps);
+          attempt_substeps  = 0;
+          if (substeps != k)
+            {
+              report.retaken   = true;
+              report.time_step = seconds_since(step_start);
+            }
+          return report;
+        }
+      catch (const StepTooLong &fault)
+        {
+          attempt_substeps          = 0;
+          const unsigned int needed = std::min<double>(
+            most_retake_substeps, std::max(std::ceil(h * fault.speed / (0.25 * system.min_radius())), 2.0 * substeps));
+          if (needed <= substeps) // only an overlap stops here (check_foresight() asks for more sub-steps)
+            throw RunError(std::string(fault.what()) +
+                           (substeps == k ? "; taking the step again would need more than " + retake_entry + " = " +
+                                              std::to_string(most_retake_substeps) + " sub-steps"
+                                          : "; this was the step taken again in " + std::to_string(substeps) +
+                                              " sub-steps, the most " + retake_entry + " allows"));
+          for (std::size_t b = 0; b < system.bodies.size(); ++b)
+            {
+              RigidBody &body = system.bodies[b];
+              body.position   = at_start[b].position;
+              body.velocity   = at_start[b].velocity;
+              body.angle      = at_start[b].angle;
+              body.spin       = at_start[b].spin;
+            }
+          // A single step that failed left the warm start as it was; sub-steps replaced it.
+          if (!impulse_at_start)
+            impulse_at_start = previous_impulse;
+          else
+            previous_impulse = *impulse_at_start;
+          if (substeps == k)
+            last_retake_reason = fault.reason;
+          substeps = needed;
+        }
+  }
+
+  void MoreauJean::check_foresight(const ParticleSystem &system, double h) const
+  {
+    // Detection found the pairs within the detection distance at the predicted configuration
+    // and those that each disc's motion estimate (disc_motion) closes; a disc that ends the
+    // step farther from the segment [0, estimate] than a quarter of the smallest radius plus
+    // that distance may have closed a pair it did not see by more than a quarter radius.
+    const double r_min = system.min_radius(), limit = 0.25 * r_min + distance;
+    double       worst = limit;
+    long         culprit = -1;
+    for (std::size_t d = 0; d < system.discs.size(); ++d)
+      {
+        // x_end - x_pred of the disc's centre (its body's, and the offset's turn for a clump's disc).
+        const Disc &disc  = system.discs[d];
+        Vec2        moved = system.bodies[disc.body].position - x_pred[disc.body];
+        if (disc.offset.x() != 0 || disc.offset.y() != 0)
+          moved += rotate(disc.offset, system.bodies[disc.body].angle) - rotate(disc.offset, angle_pred[disc.body]);
+        if (system.period > 0 && std::abs(moved.x()) > 0.5 * system.period) // wrapped in the step
+          moved.x() -= system.period * std::round(moved.x() / system.period);
+        if (moved.squaredNorm() <= worst * worst)
+          continue; // within the limit whatever was foreseen
+        const Vec2  &foreseen = disc_motion[d];
+        const double along    = foreseen.squaredNorm() > 0 ? std::clamp(moved.dot(foreseen) / foreseen.squaredNorm(), 0.0, 1.0) : 0.0;
+        if (const double unforeseen = (moved - along * foreseen).norm(); unforeseen > worst)
+          worst = unforeseen, culprit = disc.body;
+      }
+    if (culprit < 0)
+      return;
+    const RigidBody &body  = system.bodies[culprit];
+    const double     speed = std::max(body.velocity.norm(), v_begin[culprit].head<2>().norm());
+    if (std::min<double>(most_retake_substeps, std::ceil(h * attempt_substeps * speed / (0.25 * r_min))) <= attempt_substeps)
+      return;
+    std::ostringstream why;
+    why << "body " << culprit << " moved " << worst / r_min << " r_min farther than its contact detection foresaw ("
+        << speed << " m/s)";
+    throw StepTooLong(why.str(), speed, why.str());
+  }
+
+  StepReport MoreauJean::in_substeps(ParticleSystem &system, double h, unsigned int k)
+  {
     if (k == 1)
       return single_step(system, h);
     const auto                   step_start = std::chrono::steady_clock::now();
@@ -171,6 +286,10 @@ namespace tribo::dem
       update_boundary_bodies(h, report);
     compute_contact_powers(h);
     check_overlaps(system, h, report, deepest_overlap);
+    if (attempt_substeps > 0)
+      check_foresight(system, h);
+    // The next step's warm start, once the step stands (a step taken again starts from the last).
+    previous_impulse.assign(next_impulse);
     report.kinetic_energy = system.kinetic_energy();
     report.time_step      = seconds_since(step_start);
     return report;
@@ -215,14 +334,17 @@ namespace tribo::dem
       }
     // Each disc's motion until the next detection, estimated as lookahead steps at its
     // velocity at the start of the step (the centre velocity of its body, v + omega x
-    // offset). Not the free velocity: a body pressed on its neighbours by a load (h F / m,
-    // up to 1e2 m/s for a grain at 100 MPa) has its free velocity cancelled by its contacts
-    // every step, while a fast grain keeps its velocity from one step to the next.
+    // offset), plus one step of what its imposed load adds to it, h (v_free - v_begin) =
+    // h^2 M^-1 F_ext. Not lookahead steps of the free velocity: a body pressed on its
+    // neighbours by a load has its free velocity cancelled by its contacts every step, while
+    // a fast grain keeps its velocity from one step to the next. The load's own step matters
+    // for a wall released under its load (h^2 F / m = 3.4e-6 m in a first step of 2e-7 s at
+    // 100 MPa), and is below 1e-9 m at the shear cells' step.
     disc_motion.resize(system.discs.size());
     for (std::size_t d = 0; d < system.discs.size(); ++d)
       {
         const Disc            &disc   = system.discs[d];
-        const Eigen::Vector3d &v      = v_begin[disc.body];
+        const Eigen::Vector3d  v      = v_begin[disc.body] + (v_free[disc.body] - v_begin[disc.body]) / lookahead;
         const Vec2             offset = rotate(disc.offset, angle_pred[disc.body]);
         disc_motion[d] = lookahead * h * Vec2(v.x() - v.z() * offset.y(), v.y() + v.z() * offset.x());
       }
@@ -350,7 +472,6 @@ namespace tribo::dem
         eps_sum += th * h * (un - c.u_free.x());
         min_gap_end = std::min(min_gap_end, c.gap + th * h * un);
       }
-    previous_impulse.assign(next_impulse);
     if (own_share)
       {
         double sums[3] = {double(report.n_active), eps_sum, double(current.size())};
@@ -621,13 +742,19 @@ namespace tribo::dem
            << method_name(by_nlgs ? SolverParameters::Method::nlgs : solver->parameters().method) << " "
            << (report.solver.converged ? "converged" : "not converged") << "). ";
         if (deepest.moved > 0.25 * r_min)
-          os << "The farthest mover, " << mover << ", moved " << farthest << " m in the step (" << start_speed
-             << " m/s at its start, " << end_speed << " at its end); a step of at most "
-             << 0.25 * r_min / std::max(start_speed, end_speed)
-             << " s keeps it within a quarter of the smallest radius"
-             << (substeps_entry.empty() || !attached.empty() ? ""
-                 : most_substeps == 1 ? " (or set " + substeps_entry + " > 1 to take such steps in sub-steps)"
-                                      : " (or raise " + substeps_entry + ")");
+          {
+            const double fastest = std::max(start_speed, end_speed);
+            os << "The farthest mover, " << mover << ", moved " << farthest << " m in the step (" << start_speed
+               << " m/s at its start, " << end_speed << " at its end); a step of at most " << 0.25 * r_min / fastest
+               << " s keeps it within a quarter of the smallest radius"
+               << (substeps_entry.empty() || !attached.empty() ? ""
+                   : most_substeps == 1 ? " (or set " + substeps_entry + " > 1 to take such steps in sub-steps)"
+                                        : " (or raise " + substeps_entry + ")");
+            std::ostringstream why;
+            why << mover << " moved " << farthest / r_min << " r_min (" << fastest << " m/s) and left an overlap of "
+                << deepest_overlap / r_min << " r_min";
+            throw StepTooLong(os.str(), fastest, why.str());
+          }
         else
           {
             const ParameterSection &solver_section = solver->parameters().section;

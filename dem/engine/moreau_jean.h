@@ -69,6 +69,10 @@ namespace tribo::dem
     /// worst (residuals, overlaps, speeds) over them, its powers their means (so that h times
     /// a power is the step's energy), epsilon, contacts and the end state the last one's.
     unsigned int substeps = 1;
+    /// The step was too long for its motion and was taken again from its start in substeps
+    /// sub-steps (MoreauJean::allow_retakes()); its figures are the last attempt's, time_step
+    /// includes the failed attempts' time.
+    bool retaken = false;
     /// Wall time of the step and of its phases, s: detection (disc pairs and half-discs),
     /// the boundary bodies' own work (their free state in predict() and their update in
     /// finalize()), and the NLGS solve; the rest is setting up the local problems and
@@ -163,6 +167,24 @@ namespace tribo::dem
       most_substeps  = std::max(1U, most);
       substeps_entry = entry;
     }
+    /// Take a step again from its start, as k equal sub-steps (k <= @p most), when it was too
+    /// long for its motion: its motion carried a body into another past the smallest radius
+    /// (check_overlaps()'s farthest-mover case), or a disc ended it farther than contact
+    /// detection foresaw (check_foresight()). k = ceil(h v / (r_min / 4)) with v the larger of
+    /// that body's speeds at the attempt's start and end, and at least twice the attempt's
+    /// sub-steps; an attempt in k sub-steps that fails so too is followed by one in more, up
+    /// to @p most. Only such steps pay: the bodies' positions, angles and velocities at the
+    /// step's start are kept (a few doubles each), and the warm start is restored. 1: never
+    /// (the run stops at an overlap, as without). Not with attached boundary bodies.
+    /// @p entry: the case's entry that sets @p most, named by the stop.
+    void allow_retakes(unsigned int most, const std::string &entry = "")
+    {
+      most_retake_substeps = std::max(1U, most);
+      retake_entry         = entry;
+    }
+    /// Why the last retaken step was taken again (StepReport::retaken): its farthest mover,
+    /// how far it moved and the overlap it left.
+    const std::string &retake_reason() const { return last_retake_reason; }
     /// The length of the last step or, when it was taken in sub-steps, of its last sub-step
     /// (s): contacts() hold impulses over it, so a contact's force is r / step_length().
     double step_length() const { return last_step_length; }
@@ -199,6 +221,8 @@ namespace tribo::dem
     StepReport single_step(ParticleSystem &system, double h);
     /// The sub-steps of a step @p h (allow_substeps()).
     unsigned int substeps_needed(const ParticleSystem &system, double h) const;
+    /// A step @p h as @p k equal single_step()s, their reports merged (StepReport::substeps).
+    StepReport in_substeps(ParticleSystem &system, double h, unsigned int k);
     /// The law residual and gap violation of the solve that produced @p report (the residual
     /// too, unless NLGS solved the step; the solve's own when it reports them,
     /// SolveReport::law_assessed), and the step not converged above SolverParameters::gap_target
@@ -224,7 +248,8 @@ namespace tribo::dem
     /// fastest body's speed (m/s). Throws RunError on a non-finite velocity.
     double update_bodies(ParticleSystem &system, double h, StepReport &report);
     /// epsilon, the worst overlap of the loaded contacts (report) and of any contact
-    /// (returned, m); stores the loaded contacts' impulses as the next warm start.
+    /// (returned, m); gathers the loaded contacts' impulses into next_impulse, which
+    /// single_step() makes the next warm start once the step has passed check_overlaps().
     double measure_gaps(double h, StepReport &report);
     /// Each boundary body's update with its node impulses, and their powers and energies.
     void update_boundary_bodies(double h, StepReport &report);
@@ -248,10 +273,18 @@ namespace tribo::dem
     /// h |(1 - theta) v_begin + theta v_end|, and the step that keeps it within a quarter of
     /// the smallest radius. Otherwise the overlap was there at the step's start (placed, or
     /// grown over steps within the solver's tolerance): that contact's overlap then, what
-    /// the step added, and the entries that limit its growth.
+    /// the step added, and the entries that limit its growth. The first case's error is one
+    /// step() catches to take the step again in sub-steps (allow_retakes()).
     /// Collective on a step held in shares (every process throws the same message).
     void check_overlaps(const ParticleSystem &system, double h, const StepReport &report,
                         double deepest_overlap) const;
+    /// While a step that may be taken again is under way (attempt_substeps > 0): a RunError
+    /// that step() catches to take it again in more sub-steps, when a disc ended the step
+    /// farther than r_min / 4 plus the detection distance from where its contact detection's
+    /// motion estimate (disc_motion, any fraction of it) put it: a grain the solve launched may
+    /// then have closed a pair that detection did not see. Every process of a split updates
+    /// every body with the same bits, so they agree without a reduction.
+    void check_foresight(const ParticleSystem &system, double h) const;
 
     double                   th;
     ContactLaw               contact_law;
@@ -261,6 +294,18 @@ namespace tribo::dem
     double                   distance;
     unsigned int             most_substeps    = 1;
     std::string              substeps_entry; ///< allow_substeps()'s entry
+    unsigned int             most_retake_substeps = 64;
+    std::string              retake_entry; ///< allow_retakes()'s entry
+    std::string              last_retake_reason;
+    /// The sub-steps of the attempt of a step that may be taken again; 0 otherwise.
+    unsigned int             attempt_substeps = 0;
+    /// The bodies' state at the start of a step that may be taken again (allow_retakes()).
+    struct BodyAtStart
+    {
+      Vec2   position, velocity;
+      double angle, spin;
+    };
+    std::vector<BodyAtStart> at_start;
     double                   last_step_length = 0;
     ContactDetector          detector;
     std::vector<Contact>     found;   ///< detect()'s pairs, kept between steps with their capacity

@@ -12,15 +12,17 @@ namespace tribo::dem
     using Index = Eigen::Index;
 
     /// Reductions of a product pass at a point v: v.A'v, b'.v, the natural map, the sum and
-    /// count of the loaded impulses x_j > 0, and |A'v|^2 (for the power iterations).
+    /// count of the loaded impulses x_j > 0, |A'v|^2 (for the power iterations) and the
+    /// largest closing velocity max(0, -u~_n) (m/s).
     struct PointSums
     {
-      double vAv = 0, bv = 0, worst = 0, loaded_sum = 0, loaded = 0, norm2 = 0;
+      double vAv = 0, bv = 0, worst = 0, loaded_sum = 0, loaded = 0, norm2 = 0, closing = 0;
       void   merge(const PointSums &o)
       {
         vAv += o.vAv;
         bv += o.bv;
-        worst = std::max(worst, o.worst);
+        worst   = std::max(worst, o.worst);
+        closing = std::max(closing, o.closing);
         loaded_sum += o.loaded_sum;
         loaded += o.loaded;
         norm2 += o.norm2;
@@ -41,7 +43,7 @@ namespace tribo::dem
     constexpr double power_margin = 1.1;
   } // namespace
 
-  SolveReport ApgdSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
+  SolveReport ApgdSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law)
   {
     SolveReport report;
     const FrictionlessProblem   lcp(contacts, state, true, prm.threads);
@@ -64,7 +66,8 @@ namespace tribo::dem
             out[j] = op.row_times(v, j);
             s.vAv += v[j] * out[j];
             s.bv += b[j] * v[j];
-            s.worst = std::max(s.worst, std::abs(std::min(v[j], out[j] + b[j])) * inv_root[j]);
+            s.worst   = std::max(s.worst, std::abs(std::min(v[j], out[j] + b[j])) * inv_root[j]);
+            s.closing = std::max(s.closing, -(out[j] + b[j]) / inv_root[j]); // u~_n = g' sqrt(D)
             if (v[j] > 0)
               {
                 s.loaded_sum += v[j] * inv_root[j];
@@ -100,7 +103,13 @@ namespace tribo::dem
     auto increased = [](double f_new, double f_old) {
       return f_new - f_old > 1e-13 * (std::abs(f_new) + std::abs(f_old));
     };
-    while (at_y.relative(lcp.scale) > prm.residual_target)
+    // With IQS the solve also aims at the gap target, which a converged step must meet: its
+    // largest gap violation theta h max(0, -u~_n).
+    const double gap_target = law.type == ContactLaw::Type::iqs ? prm.gap_target : 0.0;
+    const auto   open = [&](const PointSums &at) {
+      return at.relative(lcp.scale) > prm.residual_target || (gap_target > 0 && step_theta_h * at.closing > gap_target);
+    };
+    while (open(at_y))
       {
         if (report.iterations >= prm.max_iterations)
           {

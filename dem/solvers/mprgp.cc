@@ -25,10 +25,11 @@ namespace tribo::dem
     };
 
     /// Reductions of a split pass (file comment of mprgp.h): the natural map, ||beta||^2,
-    /// phi~.phi and phi.A'p, and the sum and count of the loaded impulses x_j > 0.
+    /// phi~.phi and phi.A'p, the sum and count of the loaded impulses x_j > 0, and the largest
+    /// closing velocity max(0, -u~_n) (m/s).
     struct SplitSums
     {
-      double worst = 0, beta2 = 0, proportional = 0, phi_Ap = 0, loaded_sum = 0, loaded = 0;
+      double worst = 0, beta2 = 0, proportional = 0, phi_Ap = 0, loaded_sum = 0, loaded = 0, closing = 0;
       /// The natural map over the mean loaded impulse (over @p fallback without one).
       double relative(double fallback) const
       {
@@ -38,7 +39,8 @@ namespace tribo::dem
       {
         loaded_sum += o.loaded_sum;
         loaded += o.loaded;
-        worst = std::max(worst, o.worst);
+        worst   = std::max(worst, o.worst);
+        closing = std::max(closing, o.closing);
         beta2 += o.beta2;
         proportional += o.proportional;
         phi_Ap += o.phi_Ap;
@@ -46,7 +48,7 @@ namespace tribo::dem
     };
   } // namespace
 
-  SolveReport MprgpSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &)
+  SolveReport MprgpSolver::solve_problem(std::vector<Contact> &contacts, BodyState &state, const ContactLaw &law)
   {
     SolveReport report;
     // The walls (bodies with many contacts) as low-rank terms: A' + U'U'^T, so that a
@@ -68,7 +70,8 @@ namespace tribo::dem
     Eigen::VectorXd g(n), p(n), Ap(n), phi(n), beta(n);
     // phi_j, beta_j and the split sums of entry j; with @p Ap_known, also phi.A'p.
     auto split_entry = [&](Index j, SplitSums &s, bool with_Ap) {
-      s.worst = std::max(s.worst, std::abs(std::min(y[j], g[j])) * inv_root[j]);
+      s.worst   = std::max(s.worst, std::abs(std::min(y[j], g[j])) * inv_root[j]);
+      s.closing = std::max(s.closing, -g[j] / inv_root[j]); // u~_n = g sqrt(D)
       if (y[j] > 0)
         {
           phi[j]  = g[j];
@@ -140,7 +143,11 @@ namespace tribo::dem
     };
 
     SplitSums split = gradient_and_split();
-    while (split.relative(lcp.scale) > prm.residual_target)
+    // With IQS the solve also aims at the gap target, which a converged step must meet: its
+    // largest gap violation theta h max(0, -u~_n).
+    const double gap_target = law.type == ContactLaw::Type::iqs ? prm.gap_target : 0.0;
+    while (split.relative(lcp.scale) > prm.residual_target ||
+           (gap_target > 0 && step_theta_h * split.closing > gap_target))
       {
         if (report.iterations >= prm.max_iterations)
           {

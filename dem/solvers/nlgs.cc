@@ -46,9 +46,10 @@ namespace tribo::dem
                       "(docs/performance.md).");
     prm.declare_entry("Gap tolerance", "0", Double(),
                       "NLGS and APGS: extra IQS convergence criterion, as a fraction of the smallest radius "
-                      "(>= 0; 0: off, NLGS's norms or APGS's Residual target only): every contact's gap "
-                      "violation theta h max(0, -(u_n + shift)) must be below it. Limits the overlaps that "
-                      "a loose solve lets accumulate under high pressure, at the price of more sweeps.");
+                      "(>= 0): every contact's gap violation theta h max(0, -(u_n + shift)) must be below it. "
+                      "Limits the overlaps that a loose solve lets accumulate under high pressure, at the price "
+                      "of more sweeps. 0: NLGS's norms alone; APGS then solves to Solver/Gap target, which a "
+                      "converged step must meet anyway.");
   }
 
   void NlgsSolver::parse(const ParameterFile &f, SolverParameters &p)

@@ -14,6 +14,7 @@ Usage: test_shear_physics.py PATH/TO/tribo
 """
 import concurrent.futures
 import json
+import math
 import os
 import re
 import subprocess
@@ -235,29 +236,38 @@ class ProfilesOfABouncingWall(unittest.TestCase):
 
 
 class WallThroughLayer(unittest.TestCase):
-    """A step far too large with no compaction speed limit: the upper wall tunnels
-    into the layer. The run must stop as failed, naming the cause, not end
-    'complete' with nonsense (negative solid fraction)."""
+    """A step far too large (2e-7 s, 100 times the cell's) with no compaction speed limit:
+    the released upper wall drives grains through each other. Without retakes the run must
+    stop as failed, naming the cause, not end 'complete' with nonsense (negative solid
+    fraction); with them (the default) the steps are taken again in sub-steps, and the run
+    completes."""
 
-    def test_run_stops_with_the_reason(self):
+    def run_case(self, tmp, name, *settings):
         case = CASE.replace("set Time step = 2e-9", "set Time step = 2e-7") \
                    .replace("set Pressure ramp time = 1e-6", "set Pressure ramp time = 0\n  set Compaction speed limit = 0") \
                    .replace("set Number of discs = 120", "set Number of discs = 60")
+        path = os.path.join(tmp, "case.prm")
+        with open(path, "w") as f:
+            f.write(case)
+        out = os.path.join(tmp, name)
+        args = [TRIBO, "run", path, "--output", out, "--quiet"]
+        for s in settings:
+            args += ["--set", s]
+        p = subprocess.run(args, capture_output=True, text=True, timeout=120)
+        with open(os.path.join(out, "summary.json")) as f:
+            summary = json.load(f)
+        with open(os.path.join(out, "log.txt")) as f:
+            log = f.read()
+        return p, summary, log
+
+    def test_run_stops_with_the_reason(self):
         with tempfile.TemporaryDirectory() as tmp:
-            path = os.path.join(tmp, "case.prm")
-            with open(path, "w") as f:
-                f.write(case)
-            out = os.path.join(tmp, "out")
-            p = subprocess.run([TRIBO, "run", path, "--output", out, "--quiet"],
-                               capture_output=True, text=True, timeout=120)
+            p, summary, log = self.run_case(tmp, "out", "Simulation/Most substeps on retake=1")
             self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
-            with open(os.path.join(out, "summary.json")) as f:
-                summary = json.load(f)
             self.assertEqual(summary["status"], "failed")
             # --quiet silences progress, not the reason: it is on stderr and in log.txt.
             self.assertEqual(p.stderr.strip(), "error: " + summary["error"])
-            with open(os.path.join(out, "log.txt")) as f:
-                self.assertIn("error: " + summary["error"], f.read())
+            self.assertIn("error: " + summary["error"], log)
             # The first symptom stops it: grains overlapping by more than a radius, with
             # the farthest mover (h |(1 - theta) v_start + theta v_end| at most h times its
             # faster speed) and a step that keeps it within a quarter radius.
@@ -272,6 +282,33 @@ class WallThroughLayer(unittest.TestCase):
             # ... or sub-steps where they are needed.
             self.assertIn(" s keeps it within a quarter of the smallest radius (or set Simulation/Most substeps > 1 "
                           "to take such steps in sub-steps)", summary["error"])
+
+    def test_steps_taken_again_in_sub_steps(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            # The first step: the wall, released under its load, pushes grains that were at rest
+            # farther than contact detection foresaw, and is taken again.
+            p, summary, log = self.run_case(tmp, "default")
+            m = re.search(r"note: step 1 \(t = 2e-07 s\) taken again in (\d+) sub-steps \(Simulation/Most substeps "
+                          r"on retake\): body \d+ moved ([0-9.e+-]+) r_min farther than its contact detection "
+                          r"foresaw \(([0-9.e+-]+) m/s\)", log)
+            self.assertIsNotNone(m, log[:3000])
+            substeps, unforeseen, speed = int(m.group(1)), float(m.group(2)), float(m.group(3))
+            self.assertGreater(unforeseen, 0.25)
+            # The smallest radius: ten times the default detection distance, which the log gives.
+            r_min = 10 * float(re.search(r"detection distance ([0-9.e+-]+) m", log).group(1))
+            self.assertEqual(substeps, math.ceil(2e-7 * speed / (0.25 * r_min) - 1e-9))
+            # Solving each step to the gap target, APGS keeps the steps' closing errors below
+            # 1e-2 r_min, and the run completes: a packed layer, its energy book closed, no
+            # overlap past the smallest radius.
+            self.assertEqual(p.returncode, 0, p.stderr)
+            self.assertEqual(summary["status"], "complete")
+            self.assertEqual(summary["gap_target_exceeded"], 0)
+            self.assertLess(summary["max_overlap_over_min_radius"], 1)
+            self.assertGreater(summary["results"]["solid_fraction_mean"], 0.75)
+            self.assertLess(summary["results"]["solid_fraction_mean"], 0.91)
+            self.assertAlmostEqual(summary["results"]["power_balance_closure"], 1, delta=0.01)
+            taken_again = int(re.search(r"(\d+) steps taken again in sub-steps", log).group(1))
+            self.assertGreater(taken_again, 10)
 
 
 if __name__ == "__main__":

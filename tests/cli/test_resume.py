@@ -105,7 +105,8 @@ class Resume(TempDirTestCase):
         self.assertEqual(r.stderr.strip(),
                          "error: --resume out: entry 'Shear cell/Sliding velocity' is '4' in the case but "
                          "'5' in the checkpoint; a resumed run may change only Solver/*, Output/*, "
-                         "Simulation/End time, Simulation/Most substeps and Shear cell/Upper body prediction depth")
+                         "Simulation/End time, Simulation/Most substeps, Simulation/Most substeps on retake and "
+                         "Shear cell/Upper body prediction depth")
         self.assertEqual(read_json(os.path.join(self.tmp, "out", "summary.json"))["status"], "interrupted",
                          "a refused resumption leaves the run as it was")
         # A checkpoint whose first count after the header is 2^60 (another build's layout,

@@ -96,7 +96,8 @@ class ResumeParticles(TempDirTestCase):
         self.assertEqual(r.stderr.strip(),
                          "error: --resume out: entry '%s' is '%s' in the case but '%s' in the "
                          "checkpoint; a resumed run may change only Solver/*, Output/*, "
-                         "Simulation/End time, Simulation/Most substeps and Shear cell/Upper body prediction depth"
+                         "Simulation/End time, Simulation/Most substeps, Simulation/Most substeps on retake and "
+                         "Shear cell/Upper body prediction depth"
                          % (entry, value, saved))
         self.assertTrue(os.path.exists(os.path.join(self.tmp, "out", "checkpoint.bin")),
                         "a refused resumption keeps the checkpoint")

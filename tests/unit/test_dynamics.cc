@@ -329,8 +329,10 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   // Closing at 200 m/s from a gap of 0.1 um in steps of 1e-8 s (2 um per step): the
   // pair is detected and stopped, but the explicit half step (1 - theta) h v carries it
   // 1 um into the overlap.
+  // (Without retakes: with them the step is taken again, below.)
   ParticleSystem fast = pair_at(2 * r + 1e-7, -200);
   MoreauJean     mj2(0.5, ContactLaw{}, tight(), 1e-6);
+  mj2.allow_retakes(1);
   EXPECT_EQ(step_error(mj2, fast, 1e-8),
             "an overlap of 9e-07 m, more than the smallest disc radius (6e-07 m): contacts were "
             "missed or left unresolved (nlgs converged). The farthest mover, body 1, moved 1.5e-06 m "
@@ -367,6 +369,51 @@ TEST(Dynamics, AnOverlapDeeperThanTheSmallestRadiusStopsTheRun)
   EXPECT_NEAR(1e-8 * report.power_contacts, -0.5 * energy_before, 1e-9 * energy_before);
   EXPECT_NEAR(mj5.contact_force()[1].x() * 1e-8, mass * 100, 1e-9 * mass * 100);
   EXPECT_NEAR(mj5.contact_force()[0].x() * 1e-8, -mass * 100, 1e-9 * mass * 100);
+  // By default the step that stopped mj2 is taken again from its start: the farthest mover's
+  // larger speed, 200 m/s, asks for ceil(h v / (r / 4)) = 14 sub-steps, and the retake ends
+  // as the sub-stepped step above, to the bit: the first attempt left nothing behind (the
+  // bodies' state restored).
+  ParticleSystem retaken = pair_at(2 * r + 1e-7, -200);
+  MoreauJean     mj6(0.5, ContactLaw{}, tight(), 1e-6);
+  const StepReport again = mj6.step(retaken, 1e-8);
+  EXPECT_TRUE(again.retaken);
+  EXPECT_FALSE(report.retaken);
+  EXPECT_EQ(again.substeps, 14u);
+  for (int b = 0; b < 2; ++b)
+    {
+      EXPECT_EQ(retaken.bodies[b].position, substepped.bodies[b].position);
+      EXPECT_EQ(retaken.bodies[b].velocity, substepped.bodies[b].velocity);
+      EXPECT_EQ(mj6.contact_force()[b], mj5.contact_force()[b]);
+    }
+  EXPECT_EQ(again.power_contacts, report.power_contacts);
+  EXPECT_EQ(mj6.retake_reason(), "body 1 moved 2.5 r_min (200 m/s) and left an overlap of 1.5 r_min");
+  // A grain the step launches from rest, farther than its contact detection foresaw: disc 1
+  // strikes disc 0 at 100 m/s (the pair seen by disc 1's motion), which leaves at 50 m/s and
+  // is carried theta h 50 = 2.5e-7 m into disc 2, 5e-8 m beyond it (farther than the
+  // detection distance of 1e-8 m, and disc 0 was at rest). Without retakes the step stands
+  // and leaves that pair 2e-7 m (0.33 r) deep, unseen until the next step, whose IQS keeps
+  // it; with them the step is taken again in ceil(h 50 / (r / 4)) = 4 sub-steps, disc 2 is met
+  // within one (0.125 r deep: two half sub-steps at 50 m/s), and the impacts pass the
+  // momentum along the row.
+  const auto row = [] {
+    ParticleSystem s = pair_at(2 * r + 1e-7, -100);
+    s.add_disc({-2 * r - 5e-8, 0}, r, rho);
+    return s;
+  };
+  const auto overlap_02 = [](const ParticleSystem &s) {
+    return 2 * r - (s.bodies[0].position - s.bodies[2].position).norm();
+  };
+  ParticleSystem unseen = row(), seen = row();
+  MoreauJean     without(0.5, ContactLaw{}, tight(), 1e-8), with(0.5, ContactLaw{}, tight(), 1e-8);
+  without.allow_retakes(1);
+  EXPECT_FALSE(without.step(unseen, 1e-8).retaken);
+  EXPECT_NEAR(overlap_02(unseen), 2.5e-7 - 5e-8, 1e-12);
+  const StepReport foreseen = with.step(seen, 1e-8);
+  EXPECT_TRUE(foreseen.retaken);
+  EXPECT_EQ(foreseen.substeps, 4u);
+  EXPECT_EQ(with.retake_reason(), "body 0 moved 0.416667 r_min farther than its contact detection foresaw (50 m/s)");
+  EXPECT_LT(overlap_02(seen), 0.13 * r);
+  EXPECT_NEAR(seen.bodies[0].velocity.x() + seen.bodies[1].velocity.x() + seen.bodies[2].velocity.x(), -100, 1e-9);
   // At 20 m/s the same pair ends each step with an overlap of at most (1 - theta) h v.
   ParticleSystem slow = pair_at(2 * r + 1e-7, -20);
   MoreauJean     mj3(0.5, ContactLaw{}, tight(), 1e-6);

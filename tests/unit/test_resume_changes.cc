@@ -102,7 +102,7 @@ TEST(ResumeChanges, TheLoadingMayNotChange)
   EXPECT_EQ(message(saved, c),
             "--resume out: entry 'Shear cell/Pressure' is '2e8' in the case but '1e8' in the "
             "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time, "
-            "Simulation/Most substeps and "
+            "Simulation/Most substeps, Simulation/Most substeps on retake and "
             "Shear cell/Upper body prediction depth");
 }
 
@@ -120,6 +120,6 @@ TEST(ResumeChanges, AnEntryNewerThanTheCheckpointIsRefusedWhenTheCaseSetsIt)
   EXPECT_EQ(message(saved, c),
             "--resume out: entry 'Shear cell/New entry' is '0.7' in the case but '(absent)' in the "
             "checkpoint; a resumed run may change only Solver/*, Output/*, Simulation/End time, "
-            "Simulation/Most substeps and "
+            "Simulation/Most substeps, Simulation/Most substeps on retake and "
             "Shear cell/Upper body prediction depth");
 }
