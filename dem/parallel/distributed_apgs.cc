@@ -19,8 +19,10 @@ namespace tribo::dem::parallel
     class RankSweeps
     {
     public:
+      /// @p gap_target (m; 0: none) and @p theta_h (s): with IQS the solve also aims at every
+      /// contact's gap violation theta h max(0, -u~_n) at most gap_target, as the serial APGS.
       RankSweeps(RankProblem &p, const ContactLaw &law, GrainExchange &exchange, MPI_Comm comm,
-                 DistributedReport &report);
+                 DistributedReport &report, double gap_target, double theta_h);
       /// APGS's projected Gauss-Seidel sweep of @p v in place, the contacts on grains of two
       /// ranks relaxed by @p omega.
       void sweep(Eigen::VectorXd &v, double omega);
@@ -30,11 +32,13 @@ namespace tribo::dem::parallel
       void sync(const Eigen::VectorXd &v);
       /// The map over every rank's contacts at @p v (exchanged), relative to the mean loaded
       /// impulse (or, with none loaded, the largest of the ranks' scales); each contact's
-      /// map is kept for the polish.
+      /// map and gap violation are kept for the polish.
       double relative_map(const Eigen::VectorXd &v);
+      /// Whether the last check's largest gap violation over every rank is above the gap target.
+      bool gaps_open() const { return gap_limit > 0 && worst_gap > gap_limit; }
       /// APGS's local polish on this rank (dem/solvers/apgs.h): polish_passes passes over
       /// its contacts whose map is above @p target times the mean loaded impulse of the last
-      /// check and their neighbours up to polish_rings rings away in A' (at most
+      /// check (or whose gap violation is above the gap target) and their neighbours up to polish_rings rings away in A' (at most
       /// polish_fraction of its contacts), @p y changed in place and @p z by the same amount;
       /// the contacts on grains of two ranks relaxed by @p omega. Then (collective) the
       /// exchange of the interface contacts' impulses and the map again, recomputed only where
@@ -42,8 +46,8 @@ namespace tribo::dem::parallel
       /// contacts, into @p map. False, with nothing exchanged or changed, when no rank had
       /// anything to polish.
       bool polish(Eigen::VectorXd &y, Eigen::VectorXd &z, double target, double omega, double &map);
-      /// Polishes after a check whose map @p map is above @p target, as APGS's: until one
-      /// reaches the target (true: @p y is the answer), no rank has anything to polish, or
+      /// Polishes after a check whose map @p map is above @p target (or whose gaps are open), as
+      /// APGS's: until one reaches the target with the gaps closed (true: @p y is the answer), no rank has anything to polish, or
       /// polish_patience polishes in a row have not lowered the map (at most max_polishes).
       /// @p map becomes the last one; with friction a polished iterate below @p best_map
       /// becomes the safeguard's @p best.
@@ -76,12 +80,20 @@ namespace tribo::dem::parallel
       /// chunk_size consecutive contacts; this rank's loaded impulses' sum (N s/m) and count.
       /// A polish updates them where it changed the iterate or the maps.
       std::vector<double>          error, chunk_worst;
+      /// Each contact's gap violation at the last check and the largest of each chunk (m), the
+      /// largest over every rank, the gap target (m; 0: none) and theta h (s).
+      std::vector<double>          gap, chunk_gap;
+      double                       worst_gap = 0;
+      const double                 gap_limit, theta_h;
       double                       loaded_sum = 0, loaded_count = 0;
       static constexpr Eigen::Index chunk_size = 64;
       double                       mean_loaded = 0; ///< over all ranks at the last check, N s/m
       std::vector<Eigen::Index>    local, affected_rows, dirty_chunks; ///< the polish's contacts, the maps it changed
       std::vector<char>            marked, affected, dirty;
 
+      /// Contact @p j's map and gap violation into error and gap, from its normal row's
+      /// gradient @p g_n at @p v (op set to v).
+      void measure(const Eigen::VectorXd &v, Eigen::Index j, double g_n);
       /// Contact @p j's contribution to the loaded impulses at @p v, added with @p sign.
       void count_loaded(const Eigen::VectorXd &v, Eigen::Index j, double sign);
       /// The map over all ranks from chunk_worst and the loaded sums (two reductions),
@@ -94,7 +106,7 @@ namespace tribo::dem::parallel
     };
 
     RankSweeps::RankSweeps(RankProblem &p, const ContactLaw &law, GrainExchange &exchange, MPI_Comm comm,
-                           DistributedReport &report)
+                           DistributedReport &report, double gap_target, double theta_h)
       : p(p)
       , law(law)
       , exchange(exchange)
@@ -108,6 +120,10 @@ namespace tribo::dem::parallel
       , mine(p.serial_body.size())
       , error(p.contacts.size(), 0)
       , chunk_worst((p.contacts.size() + chunk_size - 1) / chunk_size, 0)
+      , gap(p.contacts.size(), 0)
+      , chunk_gap(chunk_worst.size(), 0)
+      , gap_limit(law.type == ContactLaw::Type::iqs && theta_h > 0 ? gap_target : 0.0)
+      , theta_h(theta_h)
       , marked(p.contacts.size(), 0)
       , affected(p.contacts.size(), 0)
       , dirty(chunk_worst.size(), 0)
@@ -197,15 +213,24 @@ namespace tribo::dem::parallel
       loaded_sum = loaded_count = 0;
       for (Eigen::Index c = 0; c < Eigen::Index(chunk_worst.size()); ++c)
         {
-          chunk_worst[c] = 0;
+          chunk_worst[c] = chunk_gap[c] = 0;
           for (Eigen::Index j = c * chunk_size; j < std::min(n, (c + 1) * chunk_size); ++j)
             {
-              error[j]       = sweep_problem.contact_map(op, b, v, j, op.row_times(v, w * j) + b[w * j]);
+              measure(v, j, op.row_times(v, w * j) + b[w * j]);
               chunk_worst[c] = std::max(chunk_worst[c], error[j]);
+              chunk_gap[c]   = std::max(chunk_gap[c], gap[j]);
               count_loaded(v, j, 1);
             }
         }
       return reduced_map();
+    }
+
+    void RankSweeps::measure(const Eigen::VectorXd &v, Eigen::Index j, double g_n)
+    {
+      error[j] = sweep_problem.contact_map(op, b, v, j, g_n);
+      // u~_n = g_n sqrt(D) (m/s): its closing part times theta h.
+      if (gap_limit > 0)
+        gap[j] = theta_h * std::max(0.0, -g_n) / sweep_problem.scaled.inv_root[sweep_problem.width * j];
     }
 
     void RankSweeps::count_loaded(const Eigen::VectorXd &v, Eigen::Index j, double sign)
@@ -222,16 +247,18 @@ namespace tribo::dem::parallel
     {
       ++report.checks;
       report.reductions += 2;
-      const double worst       = chunk_worst.empty() ? 0 : *std::max_element(chunk_worst.begin(), chunk_worst.end());
-      const double maxima[2]   = {worst, sweep_problem.scale};
-      const double loaded[2]   = {loaded_sum, loaded_count};
-      double       global_max[2], global_loaded[2];
+      const double worst     = chunk_worst.empty() ? 0 : *std::max_element(chunk_worst.begin(), chunk_worst.end());
+      const double gaps      = chunk_gap.empty() ? 0 : *std::max_element(chunk_gap.begin(), chunk_gap.end());
+      const double maxima[3] = {worst, sweep_problem.scale, gaps};
+      const double loaded[2] = {loaded_sum, loaded_count};
+      double       global_max[3], global_loaded[2];
       {
         const CommunicationTime timed(report);
         dealii::Utilities::MPI::max(maxima, comm, global_max);
         dealii::Utilities::MPI::sum(loaded, comm, global_loaded);
       }
       mean_loaded = global_loaded[1] > 0 ? global_loaded[0] / global_loaded[1] : global_max[1];
+      worst_gap   = global_max[2];
       return global_max[0] / mean_loaded;
     }
 
@@ -248,10 +275,13 @@ namespace tribo::dem::parallel
           }
       };
       local.clear();
+      const auto open = [&](double map_of, double gap_of) {
+        return map_of > threshold || (gap_limit > 0 && gap_of > gap_limit);
+      };
       for (Eigen::Index c = 0; c < Eigen::Index(chunk_worst.size()); ++c)
-        if (chunk_worst[c] > threshold)
+        if (open(chunk_worst[c], chunk_gap[c]))
           for (Eigen::Index j = c * chunk_size; j < std::min(n, (c + 1) * chunk_size); ++j)
-            if (error[j] > threshold)
+            if (open(error[j], gap[j]))
               {
                 marked[j] = 1;
                 local.push_back(j);
@@ -299,7 +329,7 @@ namespace tribo::dem::parallel
       op.set_vector(y);
       for (const Eigen::Index j : affected_rows)
         {
-          error[j]    = sweep_problem.contact_map(op, b, y, j, op.row_times(y, w * j) + b[w * j]);
+          measure(y, j, op.row_times(y, w * j) + b[w * j]);
           affected[j] = 0;
           if (!dirty[j / chunk_size])
             {
@@ -312,6 +342,7 @@ namespace tribo::dem::parallel
         {
           chunk_worst[c] = *std::max_element(error.begin() + c * chunk_size,
                                              error.begin() + std::min(n, (c + 1) * chunk_size));
+          chunk_gap[c]   = *std::max_element(gap.begin() + c * chunk_size, gap.begin() + std::min(n, (c + 1) * chunk_size));
           dirty[c]       = 0;
         }
       dirty_chunks.clear();
@@ -329,7 +360,7 @@ namespace tribo::dem::parallel
         {
           if (!polish(y, z, target, omega, map))
             break;
-          if (map <= target)
+          if (map <= target && !gaps_open())
             return true;
           if (sweep_problem.width == 2 && map < best_map)
             {
@@ -370,7 +401,7 @@ namespace tribo::dem::parallel
   {
     DistributedReport report;
     report.neighbours = exchange.neighbours();
-    RankSweeps             rank(p, law, exchange, comm, report);
+    RankSweeps             rank(p, law, exchange, comm, report, controls.gap_target, theta_h);
     const SweepProblem    &problem = rank.problem();
     const Eigen::Index     w = problem.width, rows = w * problem.n_contacts();
 
@@ -392,7 +423,7 @@ namespace tribo::dem::parallel
           {
             rank.sync(next);
             map = rank.relative_map(next);
-            if (map <= controls.residual_target)
+            if (map <= controls.residual_target && !rank.gaps_open())
               {
                 y.swap(next);
                 report.converged = true;

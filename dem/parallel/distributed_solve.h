@@ -19,6 +19,9 @@ namespace tribo::dem::parallel
   struct DistributedControls
   {
     double       residual_target = 1e-4;  ///< stop below this global relative law residual
+    /// DistributedApgs with IQS: and with every contact's gap violation theta h max(0, -u~_n)
+    /// at most this (m; 0: not checked), as the serial APGS aims at SolverParameters::gap_target.
+    double       gap_target = 0;
     unsigned int max_sweeps      = 10000; ///< then stop, not converged
     unsigned int check_interval  = 10;    ///< sweeps between law-residual checks
     /// Nesterov's momentum on the sweeps with the gradient restart, as APGS (dem/solvers/apgs.h)

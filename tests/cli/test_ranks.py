@@ -276,6 +276,23 @@ class Ranks(TempDirTestCase):
         last = [float(statistics(os.path.join(self.tmp, out))[-1][column["solid_fraction"]]) for out in ("one", "two")]
         self.assertLess(abs(last[1] - last[0]), 0.01, last)
 
+    def test_apgs_on_two_ranks_solves_to_the_gap_target(self):
+        # Ten times the case's step: at APGS's residual target alone the steps' closing errors
+        # pass the gap target (0.01 r_min) and grow an overlap to the smallest radius; solving
+        # each step to the gap target too, as the serial APGS does, the two ranks complete.
+        args = ["--quiet", "--set", "Simulation/Time step=2e-8", "--set", "Simulation/End time=8e-6"]
+        r = self.run_ranks(2, ["run", "case.prm", "--output", "aimed"] + args)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        aimed = read_json(os.path.join(self.tmp, "aimed", "summary.json"))
+        self.assertEqual((aimed["status"], aimed["steps"], aimed["gap_target_exceeded"]), ("complete", 400, 0))
+        self.assertLessEqual(aimed["gap_violation_max"], 0.01 * aimed["max_overlap"] / aimed["max_overlap_over_min_radius"])
+        self.assertLess(aimed["max_overlap_over_min_radius"], 1)
+        # Told to stop at a gap of a whole radius, they only flag the steps above the target
+        # (and stop at step 279 of 400, an overlap past the radius).
+        self.run_ranks(2, ["run", "case.prm", "--output", "flagged", "--set", "Solver/Gap tolerance=1"] + args)
+        flagged = read_json(os.path.join(self.tmp, "flagged", "summary.json"))
+        self.assertGreater(flagged["gap_target_exceeded"], 10)
+
     def assert_refused(self, out, entries, message):
         """On two ranks, the case with @p entries set stops with @p message once and writes nothing."""
         args = ["run", "case.prm", "--output", out]
