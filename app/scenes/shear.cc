@@ -468,7 +468,10 @@ namespace tribo::app
           j.set("power_balance_ratio_stderr", batch_standard_error(ratio));
         }
         // The whole balance: what the walls put in goes into dissipation (contacts and a
-        // deformable body's damping) or into the energy the grains and the body hold.
+        // deformable body's damping) or into the energy the grains and the body hold. Over the
+        // rows after the window's first, whose powers are the steps between the two energies
+        // (with one row per step the books then close to round-off; the means above also
+        // count the first row's step, which came before it).
         {
           const auto   e_grains = stats.column("kinetic_energy");
           const auto   e_body_k = stats.column("kinetic_energy_upper_wall");
@@ -480,10 +483,18 @@ namespace tribo::app
           };
           const double span     = time[last] - time[first];
           const double rate     = span > 0 ? (energy(last) - energy(first)) / span : 0.0;
-          const double p_damp   = stat("power_damping_upper_body").first;
+          const auto   after_first = [&](const std::string &name) {
+            const auto v   = stats.column(name);
+            double     sum = 0;
+            for (std::size_t i = first + 1; i <= last; ++i)
+              sum += v[i];
+            return last > std::size_t(first) ? sum / double(last - first) : 0.0;
+          };
+          const double put_in = after_first("power_lower_wall") + after_first("power_upper_wall");
           j.set("energy_rate_mean", rate);
           j.set("power_balance_closure",
-                p_lb + p_ub != 0 ? (p_diss + p_damp + rate) / (p_lb + p_ub) : NAN);
+                put_in != 0 ? (after_first("power_dissipated") + after_first("power_damping_upper_body") + rate) / put_in
+                            : NAN);
         }
         j.set("inertial_number", std::abs(k.sliding_velocity) / h_tb * mean_grain_diameter *
                                    std::sqrt(k.density / k.pressure));
