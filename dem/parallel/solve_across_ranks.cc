@@ -65,7 +65,7 @@ namespace tribo::dem::parallel
     DistributedControls controls;
     controls.residual_target = prm.residual_target;
     controls.max_sweeps      = prm.max_iterations;
-    controls.gap_target      = prm.gap_tolerance > 0 ? prm.gap_tolerance : prm.gap_target; // as ApgsSolver's
+    controls.gap_target      = prm.apgs_gap_stop();
     if (nlgs)
       {
         controls.momentum           = false;

@@ -47,9 +47,8 @@ namespace tribo::dem
       const Eigen::Index                  n, w, rows; ///< contacts; rows per contact (w j, ..., w j + w - 1: contact j)
       ScaledOperator                      op;
       Eigen::VectorXd                     error;         ///< each contact's map at the last check, N s/m
-      /// The gap violation a check passes with IQS (m; 0: no gap test): SolverParameters::
-      /// gap_tolerance, or when it is 0 the gap target (the step's convergence asks for both
-      /// tests, so the solve aims at both); and theta h (s).
+      /// The gap violation a check passes with IQS (m; 0: no gap test),
+      /// SolverParameters::apgs_gap_stop(); and theta h (s).
       const double                        gap_tolerance, theta_h;
       Eigen::VectorXd                     gap;           ///< each contact's gap violation at the last check, m
       double                              mean_loaded;   ///< the mean loaded impulse at the last check, N s/m
@@ -89,9 +88,7 @@ namespace tribo::dem
       , rows(w * n)
       , op(scaled)
       , error(n)
-      , gap_tolerance(law.type != ContactLaw::Type::iqs || theta_h <= 0 ? 0.0
-                      : prm.gap_tolerance > 0                           ? prm.gap_tolerance
-                                                                        : prm.gap_target)
+      , gap_tolerance(law.type == ContactLaw::Type::iqs && theta_h > 0 ? prm.apgs_gap_stop() : 0.0)
       , theta_h(theta_h)
       , gap(n)
       , mean_loaded(problem.scale)

@@ -123,6 +123,9 @@ namespace tribo::dem
     /// Solver/Gap target as the case gives it, a fraction of the smallest radius (the run sets
     /// gap_target = this times the smallest radius).
     double relative_gap_target = 0.01;
+    /// The largest gap violation at which APGS (serial or across ranks) stops, m (0: none):
+    /// gap_tolerance, or when it is 0 the gap target, which a converged step must meet anyway.
+    double apgs_gap_stop() const { return gap_tolerance > 0 ? gap_tolerance : gap_target; }
     /// The case subsection these controls were read from: messages name entries through it.
     ParameterSection section;
 
