@@ -22,19 +22,18 @@ namespace tribo::dem::parallel
         return disc_height(system, c.disc[1]);
       return 0.5 * (disc_height(system, c.disc[0]) + disc_height(system, c.disc[1]));
     }
-
-    /// Bodies of one disc (grains); the others (clumps) are replicated.
-    std::vector<bool> grains_of(const ParticleSystem &system)
-    {
-      std::vector<unsigned int> discs(system.bodies.size(), 0);
-      for (const Disc &d : system.discs)
-        ++discs[d.body];
-      std::vector<bool> grain(system.bodies.size());
-      for (std::size_t b = 0; b < grain.size(); ++b)
-        grain[b] = discs[b] == 1;
-      return grain;
-    }
   } // namespace
+
+  std::vector<bool> grains_of(const ParticleSystem &system)
+  {
+    std::vector<unsigned int> discs(system.bodies.size(), 0);
+    for (const Disc &d : system.discs)
+      ++discs[d.body];
+    std::vector<bool> grain(system.bodies.size());
+    for (std::size_t b = 0; b < grain.size(); ++b)
+      grain[b] = discs[b] == 1;
+    return grain;
+  }
 
   std::vector<double> disc_heights(const ParticleSystem &system)
   {

@@ -42,6 +42,8 @@ namespace tribo::dem::parallel
     unsigned int n_replicated() const { return static_cast<unsigned int>(serial_body.size()) - n_owned - n_ghost; }
   };
 
+  /// Whether each body is a grain (a body of one disc), not a clump (the walls).
+  std::vector<bool> grains_of(const ParticleSystem &system);
   /// The height of each disc's centre, m (a grain's: its body's position).
   std::vector<double> disc_heights(const ParticleSystem &system);
   /// The height of each contact's midpoint between its two disc centres (a half-disc

@@ -1,0 +1,197 @@
+#include "dem/parallel/grain_ownership.h"
+
+#include "dem/parallel/all_gather.h"
+#include "dem/parallel/rank_problem.h"
+
+#include <boost/serialization/vector.hpp>
+
+#include <deal.II/base/mpi.h>
+
+#include <map>
+
+namespace tribo::dem::parallel
+{
+  namespace
+  {
+    /// Doubles per grain's state in a message: serial body number, x, y, angle, vx, vy, spin.
+    constexpr std::size_t state_width = 7;
+  } // namespace
+
+  GrainOwnership::GrainOwnership(MPI_Comm comm, double margin)
+    : comm(comm)
+    , rank(dealii::Utilities::MPI::this_mpi_process(comm))
+    , ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
+    , margin(margin)
+  {}
+
+  std::vector<unsigned int> GrainOwnership::ghost_ranks(double y) const
+  {
+    std::vector<unsigned int> to;
+    for (unsigned int s = 0; s < bands.n_bands(); ++s)
+      if (s != rank && y >= bands.cut[s] - margin && y < bands.cut[s + 1] + margin)
+        to.push_back(s);
+    return to;
+  }
+
+  void GrainOwnership::start(const ParticleSystem &system, const BandPartition &partition)
+  {
+    bands = partition;
+    grain = grains_of(system);
+    const std::size_t n = system.bodies.size();
+    held_flag.assign(n, 0);
+    owner_of.assign(n, 0);
+    global.assign(n, 0);
+    for (std::size_t b = 0; b < n; ++b)
+      {
+        if (!grain[b])
+          {
+            held_flag[b] = 1;
+            continue;
+          }
+        const double y = system.bodies[b].position.y();
+        owner_of[b]    = bands.band_of(y);
+        held_flag[b]   = owner_of[b] == rank || (y >= bands.cut[rank] - margin && y < bands.cut[rank + 1] + margin);
+      }
+    number(system);
+  }
+
+  void GrainOwnership::exchange(ParticleSystem &system)
+  {
+    // The owners' states to the ranks that hold them as ghosts from now on.
+    std::map<unsigned int, std::vector<double>> out;
+    for (const unsigned int b : owned_grains)
+      {
+        const RigidBody &body = system.bodies[b];
+        for (const unsigned int s : ghost_ranks(body.position.y()))
+          out[s].insert(out[s].end(), {double(b), body.position.x(), body.position.y(), body.angle,
+                                       body.velocity.x(), body.velocity.y(), body.spin});
+      }
+    const auto in = dealii::Utilities::MPI::some_to_some(comm, out);
+
+    // What this rank holds now: the grains it owned that are still in its widened band, and
+    // the ones received; each owned by the band of its centre.
+    for (const unsigned int b : held_bodies)
+      if (grain[b])
+        held_flag[b] = 0;
+    for (const unsigned int b : owned_grains)
+      {
+        const double y = system.bodies[b].position.y();
+        owner_of[b]    = bands.band_of(y);
+        held_flag[b]   = owner_of[b] == rank || (y >= bands.cut[rank] - margin && y < bands.cut[rank + 1] + margin);
+      }
+    for (const auto &[from, states] : in)
+      for (std::size_t i = 0; i + state_width <= states.size(); i += state_width)
+        {
+          const auto b    = static_cast<unsigned int>(states[i]);
+          RigidBody &body = system.bodies[b];
+          body.position   = {states[i + 1], states[i + 2]};
+          body.angle      = states[i + 3];
+          body.velocity   = {states[i + 4], states[i + 5]};
+          body.spin       = states[i + 6];
+          owner_of[b]     = bands.band_of(body.position.y());
+          held_flag[b]    = 1;
+        }
+    number(system);
+  }
+
+  void GrainOwnership::number(const ParticleSystem &system)
+  {
+    held_bodies.clear();
+    owned_grains.clear();
+    for (unsigned int b = 0; b < held_flag.size(); ++b)
+      if (held_flag[b])
+        {
+          held_bodies.push_back(b);
+          if (grain[b] && owner_of[b] == rank)
+            owned_grains.push_back(b);
+        }
+    const std::vector<std::uint64_t> counts = dealii::Utilities::MPI::all_gather(comm, std::uint64_t(owned_grains.size()));
+    std::uint64_t first = 0;
+    total               = 0;
+    for (unsigned int s = 0; s < ranks; ++s)
+      {
+        if (s < rank)
+          first += counts[s];
+        total += counts[s];
+      }
+    std::map<unsigned int, std::vector<double>> out;
+    for (const unsigned int b : owned_grains)
+      {
+        global[b] = first++;
+        for (const unsigned int s : ghost_ranks(system.bodies[b].position.y()))
+          out[s].insert(out[s].end(), {double(b), double(global[b])});
+      }
+    for (const auto &[from, numbers] : dealii::Utilities::MPI::some_to_some(comm, out))
+      for (std::size_t i = 0; i + 2 <= numbers.size(); i += 2)
+        global[static_cast<unsigned int>(numbers[i])] = static_cast<std::uint64_t>(numbers[i + 1]);
+  }
+
+  void GrainOwnership::sum_on_owners(std::vector<Eigen::Vector3d> &per_body) const
+  {
+    std::map<unsigned int, std::vector<double>> out;
+    std::vector<double>                         replicated;
+    for (const unsigned int b : held_bodies)
+      if (!grain[b])
+        replicated.insert(replicated.end(), per_body[b].data(), per_body[b].data() + 3);
+      else if (owner_of[b] != rank)
+        {
+          if (!per_body[b].isZero())
+            out[owner_of[b]].insert(out[owner_of[b]].end(), {double(b), per_body[b].x(), per_body[b].y(), per_body[b].z()});
+          per_body[b].setZero();
+        }
+    for (const auto &[from, entries] : dealii::Utilities::MPI::some_to_some(comm, out))
+      for (std::size_t i = 0; i + 4 <= entries.size(); i += 4)
+        per_body[static_cast<unsigned int>(entries[i])] += Eigen::Vector3d(entries[i + 1], entries[i + 2], entries[i + 3]);
+    const int count = static_cast<int>(replicated.size());
+    if (rank == 0)
+      MPI_Reduce(MPI_IN_PLACE, replicated.data(), count, MPI_DOUBLE, MPI_SUM, 0, comm);
+    else
+      MPI_Reduce(replicated.data(), nullptr, count, MPI_DOUBLE, MPI_SUM, 0, comm);
+    MPI_Bcast(replicated.data(), count, MPI_DOUBLE, 0, comm);
+    std::size_t k = 0;
+    for (const unsigned int b : held_bodies)
+      if (!grain[b])
+        per_body[b] = Eigen::Vector3d(replicated[k], replicated[k + 1], replicated[k + 2]), k += 3;
+  }
+
+  void GrainOwnership::gather(ParticleSystem &system)
+  {
+    struct Record
+    {
+      std::uint64_t body, global;
+      double        state[6];
+    };
+    std::vector<Record> mine;
+    mine.reserve(owned_grains.size());
+    for (const unsigned int b : owned_grains)
+      {
+        const RigidBody &body = system.bodies[b];
+        mine.push_back({b, global[b], {body.position.x(), body.position.y(), body.angle, body.velocity.x(),
+                                       body.velocity.y(), body.spin}});
+      }
+    const std::vector<unsigned int> owners = [&] {
+      std::vector<unsigned int> o;
+      const std::vector<std::uint64_t> counts = dealii::Utilities::MPI::all_gather(comm, std::uint64_t(mine.size()));
+      for (unsigned int s = 0; s < ranks; ++s)
+        o.insert(o.end(), counts[s], s);
+      return o;
+    }();
+    const std::vector<Record> every = all_gathered(mine, comm);
+    for (std::size_t i = 0; i < every.size(); ++i)
+      {
+        const Record &r    = every[i];
+        RigidBody    &body = system.bodies[r.body];
+        body.position      = {r.state[0], r.state[1]};
+        body.angle         = r.state[2];
+        body.velocity      = {r.state[3], r.state[4]};
+        body.spin          = r.state[5];
+        owner_of[r.body]   = owners[i];
+        global[r.body]     = r.global;
+        held_flag[r.body]  = 1;
+      }
+    held_bodies.clear();
+    for (unsigned int b = 0; b < held_flag.size(); ++b)
+      if (held_flag[b])
+        held_bodies.push_back(b);
+  }
+} // namespace tribo::dem::parallel

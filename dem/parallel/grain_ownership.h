@@ -1,0 +1,88 @@
+#pragma once
+/// @file Which rank holds which grain when the state of a case on several MPI ranks is split
+/// over them (dem/parallel/README.md): a rank owns the grains whose centre lies in its band,
+/// holds as ghosts the grains whose centre lies within a margin of its band, and the walls
+/// (clumps: a few degrees of freedom) are replicated. Each rank advances only what it owns;
+/// exchange() then sends the owners' states to the ranks that hold them as ghosts, and a
+/// grain that crossed into another band, that band's ghost until then, is owned there
+/// (migration: no grain lost or held twice as owned). Not yet used by runs, which still hold
+/// and advance the whole state on every rank (docs/scaling.md, "Not yet").
+
+#include "dem/engine/particle_system.h"
+#include "dem/parallel/band_partition.h"
+
+#include <Eigen/Core>
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace tribo::dem::parallel
+{
+  class GrainOwnership
+  {
+  public:
+    /// Collective over @p comm. @p margin (m): how far beyond its band a rank holds grains. A
+    /// contact belongs to the band of its discs' midpoint, so a rank's contacts reach r_max +
+    /// (detection distance) / 2 beyond its band; the margin adds the farthest a grain moves
+    /// between two exchanges (a step moves no disc more than r_min / 4: docs/laws.md, "Retakes").
+    GrainOwnership(MPI_Comm comm, double margin);
+
+    /// Every rank holds the whole of @p system with the same bits (at the start of a run, or
+    /// after gather()): each grain is owned by the band of its centre's height under @p bands
+    /// and numbered (global_number()).
+    void start(const ParticleSystem &system, const BandPartition &bands);
+
+    /// Collective, after each rank has advanced the grains it owns: each owned grain's state
+    /// (position, angle, velocity, spin) goes to every other rank whose band widened by the
+    /// margin holds its new centre, which overwrites its copy. Then every rank owns the grains
+    /// it holds whose centre lies in its band, and they are numbered again. The states of the
+    /// grains a rank does not hold are left as they were (stale).
+    void exchange(ParticleSystem &system);
+
+    /// Collective: @p per_body (one entry per body, e.g. the contact forces of this rank's
+    /// contacts) summed where each body is advanced: a ghost grain's entry is added to its
+    /// owner's and zeroed here; a replicated body's entries are summed over the ranks (reduced
+    /// on rank 0 and broadcast: the same bits on every rank).
+    void sum_on_owners(std::vector<Eigen::Vector3d> &per_body) const;
+
+    /// Collective: every grain's state from its owner onto every rank (the whole state again,
+    /// as at start(); the ownership is kept, and every grain is held until the next exchange()).
+    void gather(ParticleSystem &system);
+
+    /// Whether this rank owns grain @p body (false for a replicated body).
+    bool owns(unsigned int body) const { return grain[body] && held_flag[body] && owner_of[body] == rank; }
+    /// Whether this rank's copy of @p body is current: an owned or ghost grain, or a replicated body.
+    bool holds(unsigned int body) const { return held_flag[body] != 0; }
+    /// The rank that owns held grain @p body.
+    unsigned int owner(unsigned int body) const { return owner_of[body]; }
+    /// The global number of held grain @p body: the grains of band 0 first, each band's in
+    /// serial order (each rank owns one contiguous range, as deal.II's partitioner wants).
+    std::uint64_t global_number(unsigned int body) const { return global[body]; }
+    /// The held bodies in serial order.
+    const std::vector<unsigned int> &held() const { return held_bodies; }
+    /// The grains this rank owns, in serial order.
+    const std::vector<unsigned int> &owned() const { return owned_grains; }
+    /// Grains on all ranks.
+    std::uint64_t n_grains() const { return total; }
+    /// The ranks other than this one whose band widened by the margin holds height @p y.
+    std::vector<unsigned int> ghost_ranks(double y) const;
+
+  private:
+    MPI_Comm                   comm;
+    unsigned int               rank, ranks;
+    double                     margin;
+    BandPartition              bands;
+    std::vector<bool>          grain;        ///< bodies of one disc
+    std::vector<char>          held_flag;    ///< per body
+    std::vector<unsigned int>  owner_of;     ///< per held grain
+    std::vector<std::uint64_t> global;       ///< per held grain
+    std::vector<unsigned int>  held_bodies, owned_grains;
+    std::uint64_t              total = 0;
+
+    /// The owned and held lists from held_flag and owner_of; the owned grains' global
+    /// numbers, then the ghosts' from their owners (one message to each rank holding them).
+    void number(const ParticleSystem &system);
+  };
+} // namespace tribo::dem::parallel
