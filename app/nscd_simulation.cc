@@ -134,14 +134,15 @@ namespace tribo::app
               " has no effect on this case: its deformable first body's integrator keeps the step");
         if (const unsigned int ranks = rank_count(p.ranks); ranks > 1)
           {
-            split = std::make_shared<dem::parallel::BandSplit>(p.ranks);
+            // A rank holds the grains within a pair's reach of its band (2 r_max and the
+            // detection distance, with the motion estimates' widening) and a step's motion (r_max).
+            split = std::make_shared<dem::parallel::BandSplit>(p.ranks, 3 * system.max_radius() + distance);
             mj->use_split(split);
             mj->use_solver(std::make_unique<dem::parallel::SolveAcrossRanks>(solver, system, split));
             log("the contacts of each step split over " + std::to_string(ranks) +
                 " MPI ranks (horizontal bands of equal contact counts: each rank detects and solves its "
-                "band's, a deformable first body's on the top band's rank); every rank updates the whole "
-                "system from the contact forces summed over the ranks, first bodies included; rank 0 "
-                "writes (docs/scaling.md)");
+                "band's, a deformable first body's on the top band's rank, and advances the grains of its "
+                "band, the walls and first bodies on every rank); rank 0 writes (docs/scaling.md)");
           }
         world.integrator = mj.get();
         n_steps = std::max(1L, std::lround(std::ceil(p.end_time / h - 1e-9)));
@@ -297,6 +298,7 @@ namespace tribo::app
       /// sample and the scene's own fields.
       void write_snapshot(FieldWriter &writer) override
       {
+        mj->make_whole(system);
         const auto        &s     = system;
         const unsigned int ranks = rank_count(prm.ranks), rank = rank_in(prm.ranks);
         std::vector<double> cuts; // the bands' upper edges but the last's, m
@@ -414,6 +416,7 @@ namespace tribo::app
           }
         out.scalars["time_step"] = h;
         out.tables               = scene->tables();
+        mj->make_whole(system);
         out.final_sample         = scene->sample(system);
         if (prm.plots)
           out.plot_script = scene->plot_script();
@@ -445,7 +448,11 @@ namespace tribo::app
 
       // After the step number (the driver's): the solver's record, then every object's
       // state, in this order.
-      void prepare_checkpoint() override { mj->gather_warm_start(); }
+      void prepare_checkpoint() override
+      {
+        mj->make_whole(system);
+        mj->gather_warm_start();
+      }
       void save(CheckpointOut &ar) const override
       {
         record.save(ar);

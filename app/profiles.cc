@@ -84,10 +84,13 @@ namespace tribo::app
     // layer next to that wall.
     auto grain_layer = [&](double y) { return std::clamp(layer_of(y), 0, int(layers) - 1); };
 
-    // Velocities and areas of the discs.
+    // Velocities and areas of the discs, summed over the MPI ranks when the state is split
+    // over them (each counts the grains it owns and rank 0 the walls).
     for (std::size_t d = 0; d < s.discs.size(); ++d)
       {
         const auto  &disc = s.discs[d];
+        if (!mj.counts(disc.body))
+          continue;
         const auto  &body = s.bodies[disc.body];
         const double yc   = s.disc_centre(d).y();
         const int    k    = grain_layer(yc);
@@ -105,24 +108,35 @@ namespace tribo::app
     // Mean velocity per layer, then the fluctuations about it.
     std::vector<double> vy_mean(layers, 0.0);
     for (std::size_t d = 0; d < s.discs.size(); ++d)
-      if (s.discs[d].body != lower && s.discs[d].body != upper)
+      if (s.discs[d].body != lower && s.discs[d].body != upper && mj.counts(s.discs[d].body))
         vy_mean[grain_layer(s.disc_centre(d).y())] += s.bodies[s.discs[d].body].velocity.y();
+    {
+      std::vector<double> sums = row;
+      sums.insert(sums.end(), vy_mean.begin(), vy_mean.end());
+      mj.sum_over_shares(sums);
+      std::copy(sums.begin(), sums.begin() + row.size(), row.begin());
+      std::copy(sums.begin() + row.size(), sums.end(), vy_mean.begin());
+    }
     for (unsigned int k = 0; k < layers; ++k)
       if (row[k * n_quantities + q_count] > 0)
         {
           row[k * n_quantities + q_vx] /= row[k * n_quantities + q_count];
           vy_mean[k] /= row[k * n_quantities + q_count];
         }
+    std::vector<double> temperature(layers, 0.0);
     for (std::size_t d = 0; d < s.discs.size(); ++d)
-      if (s.discs[d].body != lower && s.discs[d].body != upper)
+      if (s.discs[d].body != lower && s.discs[d].body != upper && mj.counts(s.discs[d].body))
         {
           const int        k = grain_layer(s.disc_centre(d).y());
           const dem::Vec2 &v = s.bodies[s.discs[d].body].velocity;
           const double     n = row[k * n_quantities + q_count];
           if (n > 1)
-            row[k * n_quantities + q_temperature] +=
+            temperature[k] +=
               0.5 * (std::pow(v.x() - row[k * n_quantities + q_vx], 2) + std::pow(v.y() - vy_mean[k], 2)) / n;
         }
+    mj.sum_over_shares(temperature);
+    for (unsigned int k = 0; k < layers; ++k)
+      row[k * n_quantities + q_temperature] = temperature[k];
 
     // What the contacts add, summed over the MPI ranks when each holds its share of them.
     std::vector<double> from_contacts(row.size(), 0.0);

@@ -18,10 +18,11 @@ ranks (1.011-1.017 on two, 1.026 on four). A band must be at least two grains hi
 then joins two neighbouring bands at most): P <= H / 2.
 
 A step (docs/scaling.md, "How far this design goes"): the sweeps' share of the one-core step
-split as above, a fraction f of it done whole on every rank (predicting and updating every
-body, every disc's centre and motion), and the contact forces on every body summed over the
-ranks (24 bytes per body, a reduce and a broadcast: 2 ceil(log2 P) (alpha + 24 N / beta)):
-    E_step = 1 / ((1 - f) / E + f P + P t_sum / T_1,step).
+split as above, and a fraction f of it done whole on every rank (the passes over every body and
+disc: predicting them, their centres and motions):
+    E_step = 1 / ((1 - f) / E + f P).
+Each rank updates only its own grains, and the ghosts' forces and states cross the band
+boundaries once a step (the sweeps' exchange, once instead of some sixty times: left out).
 It leaves out what the measured two ranks add beyond the sweep model (waiting for the slower
 rank, each rank's set-up of its share): it gives 0.98 for two ranks here at 16 000 and 64 000
 grains, where they measure 0.82-0.89.
@@ -37,9 +38,9 @@ HERE = ("this machine (ping-pong, shared memory)", 0.49e-6, 5.5e9)
 NETWORKS = [HERE, ("InfiniBand HDR (typical)", 1.5e-6, 12e9), ("10 Gb Ethernet (typical)", 20e-6, 1.1e9)]
 MEASURED_T2 = {16_000: 0.449e-3, 64_000: 2.05e-3}  # s per sweep on two ranks (warm, 1e-3)
 # A step at 64 000 grains, APGS 1e-3 (docs/scaling.md, "Whole runs", commit 6925331): one core,
-# the mean of two runs, and the part every rank does whole (instrumented once on two ranks).
-STEP_PER_GRAIN = 0.366 / 64_000  # s per grain per step on one core
-WHOLE_FRACTION = 4.0e-3 / 0.366
+# the mean of two runs, and the part every rank does whole (instrumented once on two ranks:
+# predicting every body 0.85 ms, every disc's centre and motion 1.35 ms).
+WHOLE_FRACTION = (0.85e-3 + 1.35e-3) / 0.366
 
 
 def sweep_time(n, p, thickness, alpha, beta, t_c):
@@ -59,12 +60,10 @@ def efficiency(n, p, thickness, network, t_c):
 
 
 def step_efficiency(n, p, thickness, network, t_c):
-    _, alpha, beta = network
     if p == 1:
         return 1.0
-    summed = 2 * math.ceil(math.log2(p)) * (alpha + 24 * n / beta)
     f = WHOLE_FRACTION
-    return 1 / ((1 - f) / efficiency(n, p, thickness, network, t_c) + f * p + p * summed / (STEP_PER_GRAIN * n))
+    return 1 / ((1 - f) / efficiency(n, p, thickness, network, t_c) + f * p)
 
 
 def main():

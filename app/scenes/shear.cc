@@ -319,10 +319,11 @@ namespace tribo::app
         const auto  &f     = mj.contact_force();
         const auto  &power = mj.external_power();
         const double F     = normal_force;
-        double       ke_tb = 0;
+        std::vector<double> ke_tb(1, 0.0); // summed over the MPI ranks when the state is split over them
         for (std::size_t b = 0; b < s.bodies.size(); ++b)
-          if (b != lower && b != upper_body->system_body())
-            ke_tb += s.bodies[b].kinetic_energy();
+          if (b != lower && b != upper_body->system_body() && mj.counts(b))
+            ke_tb[0] += s.bodies[b].kinetic_energy();
+        mj.sum_over_shares(ke_tb);
         const coupling::FirstBodyState ub = upper_body->state(s, power);
         if (sliding && std::isnan(vy_at_shear_start))
           vy_at_shear_start = last_vy;
@@ -358,7 +359,7 @@ namespace tribo::app
         row("mu", F > 0 ? -direction * f[lower].x() / F : 0.0)("normal_force", F)
           ("lower_wall_normal_force", -f[lower].y())("upper_wall_y", ub.y)("upper_wall_vy", ub.vy)
           ("gap", gap)("power_lower_wall", power[lower])("power_upper_wall", ub.power)
-          ("power_dissipated", -r.power_contacts)("kinetic_energy_third_body", ke_tb)
+          ("power_dissipated", -r.power_contacts)("kinetic_energy_third_body", ke_tb[0])
           ("kinetic_energy_upper_wall", ub.kinetic_energy)
           ("solid_fraction", grain_area(s) / (surface_gap * k.length))
           ("elastic_energy_upper_body", ub.stored_energy)("power_damping_upper_body", r.boundary_dissipation)

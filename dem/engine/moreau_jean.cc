@@ -95,8 +95,15 @@ namespace tribo::dem
     if (most_substeps <= 1 || !attached.empty() || system.discs.empty())
       return 1;
     double fastest = 0;
-    for (const RigidBody &body : system.bodies)
-      fastest = std::max(fastest, body.velocity.norm());
+    for (std::size_t b = 0; b < system.bodies.size(); ++b)
+      if (advances(b))
+        fastest = std::max(fastest, system.bodies[b].velocity.norm());
+    if (split_state())
+      {
+        double least[1] = {-fastest};
+        split->min(least, 1);
+        fastest = -least[0];
+      }
     const double quarter = 0.25 * system.min_radius();
     return static_cast<unsigned int>(std::clamp(std::ceil(h * fastest / quarter), 1.0, double(most_substeps)));
   }
@@ -119,6 +126,8 @@ namespace tribo::dem
     std::optional<WarmStart> impulse_at_start;
     if (k > 1)
       impulse_at_start = previous_impulse;
+    if (split)
+      split->keep();
     // Each attempt that a StepTooLong stops is followed by one in more sub-steps, from the
     // step's start, until one passes or the most sub-steps allowed have failed.
     for (unsigned int substeps = k;;)
@@ -153,6 +162,8 @@ namespace tribo::dem
               body.angle      = at_start[b].angle;
               body.spin       = at_start[b].spin;
             }
+          if (split)
+            split->go_back();
           // A single step that failed left the warm start as it was; sub-steps replaced it.
           if (!impulse_at_start)
             impulse_at_start = previous_impulse;
@@ -177,6 +188,8 @@ namespace tribo::dem
       {
         // x_end - x_pred of the disc's centre (its body's, and the offset's turn for a clump's disc).
         const Disc &disc  = system.discs[d];
+        if (!advances(disc.body))
+          continue;
         Vec2        moved = system.bodies[disc.body].position - x_pred[disc.body];
         if (disc.offset.x() != 0 || disc.offset.y() != 0)
           moved += rotate(disc.offset, system.bodies[disc.body].angle) - rotate(disc.offset, angle_pred[disc.body]);
@@ -189,10 +202,14 @@ namespace tribo::dem
         if (const double unforeseen = (moved - along * foreseen).norm(); unforeseen > worst)
           worst = unforeseen, culprit = disc.body;
       }
+    double speed = culprit < 0 ? 0.0 : std::max(system.bodies[culprit].velocity.norm(), v_begin[culprit].head<2>().norm());
+    double worst_disc[3] = {double(culprit), speed, worst};
+    take_largest(worst, worst_disc, 3);
+    culprit = long(worst_disc[0]);
+    speed   = worst_disc[1];
+    worst   = worst_disc[2];
     if (culprit < 0)
       return;
-    const RigidBody &body  = system.bodies[culprit];
-    const double     speed = std::max(body.velocity.norm(), v_begin[culprit].head<2>().norm());
     if (std::min<double>(most_retake_substeps, std::ceil(h * attempt_substeps * speed / (0.25 * r_min))) <= attempt_substeps)
       return;
     std::ostringstream why;
@@ -290,7 +307,15 @@ namespace tribo::dem
       check_foresight(system, h);
     // The next step's warm start, once the step stands (a step taken again starts from the last).
     previous_impulse.assign(next_impulse);
-    report.kinetic_energy = system.kinetic_energy();
+    report.kinetic_energy = 0;
+    for (std::size_t b = 0; b < system.bodies.size(); ++b)
+      if (counts(b))
+        report.kinetic_energy += system.bodies[b].kinetic_energy();
+    if (split_state())
+      {
+        split->sum(&report.kinetic_energy, 1);
+        split->settle(system);
+      }
     report.time_step      = seconds_since(step_start);
     return report;
   }
@@ -323,9 +348,8 @@ namespace tribo::dem
 
   }
 
-  void MoreauJean::detect(const ParticleSystem &system, double h, StepReport &report)
+  void MoreauJean::place_discs(const ParticleSystem &system, double h)
   {
-    // Disc pairs at the predicted configuration.
     centres.resize(system.discs.size());
     for (std::size_t d = 0; d < system.discs.size(); ++d)
       {
@@ -348,6 +372,12 @@ namespace tribo::dem
         const Vec2             offset = rotate(disc.offset, angle_pred[disc.body]);
         disc_motion[d] = lookahead * h * Vec2(v.x() - v.z() * offset.y(), v.y() + v.z() * offset.x());
       }
+  }
+
+  void MoreauJean::detect(ParticleSystem &system, double h, StepReport &report)
+  {
+    // Disc pairs at the predicted configuration.
+    place_discs(system, h);
     auto                 phase = std::chrono::steady_clock::now();
     const unsigned int   threads = solver->parameters().threads;
     if (!split)
@@ -362,6 +392,13 @@ namespace tribo::dem
         const bool          all   = !own || share == ContactSplit::Share::search_all;
         if (share == ContactSplit::Share::search_all)
           {
+            if (split->held())
+              {
+                // Every pair at the predicted configuration of the whole state.
+                split->make_whole(system);
+                predict(system, h);
+                place_discs(system, h);
+              }
             detector.detect(system, centres, distance, threads, disc_motion, found);
             share = split->divide(system, found, true);
           }
@@ -404,6 +441,12 @@ namespace tribo::dem
             c.node[0] += first;
             c.node[1] += first;
           }
+        // With a split state, the grains this process does not hold are stale: none of
+        // their half-disc contacts is real.
+        if (split_state())
+          on_boundary.erase(std::remove_if(on_boundary.begin(), on_boundary.end(),
+                                           [&](const Contact &c) { return !split->holds(c.body[1]); }),
+                            on_boundary.end());
         if (!own_share || split->keeps_boundary_contacts())
           found.insert(found.end(), on_boundary.begin(), on_boundary.end());
       }
@@ -517,7 +560,10 @@ namespace tribo::dem
   void MoreauJean::join_shares()
   {
     // Eigen's fixed vectors of 3 and 2 doubles lie side by side in a std::vector.
-    split->sum(body_force.front().data(), 3 * body_force.size());
+    if (split->held())
+      split->sum_on_owners(body_force);
+    else
+      split->sum(body_force.front().data(), 3 * body_force.size());
     if (!node_impulse.empty())
       split->sum(node_impulse.front().data(), 2 * node_impulse.size());
   }
@@ -526,6 +572,19 @@ namespace tribo::dem
   {
     if (own_share)
       split->sum(values.data(), values.size());
+  }
+
+  void MoreauJean::take_largest(double key, double *values, std::size_t n) const
+  {
+    if (!split_state())
+      return;
+    double least[1] = {-key};
+    split->min(least, 1);
+    std::vector<double> held(n, INFINITY);
+    if (-key == least[0])
+      std::copy(values, values + n, held.begin());
+    split->min(held.data(), n);
+    std::copy(held.begin(), held.end(), values);
   }
 
   void MoreauJean::gather_warm_start()
@@ -548,8 +607,13 @@ namespace tribo::dem
     body_power.assign(nb, 0.0);
     v_mid_of.resize(nb);
     double fastest = 0; // speed of the fastest body, m/s
+    // The powers over the bodies this process counts: external, contacts, on the free bodies.
+    double power[3] = {0, 0, 0};
+    double diverged = INFINITY; // the least body with a non-finite velocity, with a split state
     for (std::size_t b = 0; b < nb; ++b)
       {
+        if (!advances(b))
+          continue;
         RigidBody &body = system.bodies[b];
         // v_end = v_free + M^-1 (total contact impulse), recomputed from the final
         // impulses rather than taken from the solver's running velocities (which
@@ -558,6 +622,11 @@ namespace tribo::dem
         Eigen::Vector3d v = v_free[b];
         for (int k = 0; k < 3; ++k)
           v[k] += h * state.inverse_mass[b][k] * body_force[b][k];
+        if (!v.allFinite() && split_state())
+          {
+            diverged = std::min(diverged, double(b)); // every process stops below
+            continue;
+          }
         if (!v.allFinite())
           {
             std::ostringstream os;
@@ -567,17 +636,21 @@ namespace tribo::dem
           }
         const Eigen::Vector3d v_mid = 0.5 * (v_begin[b] + v);
         v_mid_of[b]                 = v_mid;
+        const bool counted          = counts(b);
         for (int k = 0; k < 3; ++k)
           {
             if (body.drive[k] == Drive::velocity)
               body_power[b] -= body_force[b][k] * v_mid[k];
             else if (body.drive[k] == Drive::force)
               body_power[b] += body.load[k] * v_mid[k];
-            report.power_contacts += body_force[b][k] * v_mid[k];
+            if (!counted)
+              continue;
+            power[1] += body_force[b][k] * v_mid[k];
             if (body.is_free())
-              report.power_free += (body_force[b][k] + (body.drive[k] == Drive::force ? body.load[k] : 0)) * v_mid[k];
+              power[2] += (body_force[b][k] + (body.drive[k] == Drive::force ? body.load[k] : 0)) * v_mid[k];
           }
-        report.power_external += body_power[b];
+        if (counted)
+          power[0] += body_power[b];
         fastest = std::max(fastest, v.head<2>().norm());
         if (own_share) // the solver left only this process's bodies current (measure_gaps)
           state.velocity[b] = v;
@@ -592,6 +665,27 @@ namespace tribo::dem
             body.position.x() -= shift;
           }
       }
+    if (split_state())
+      {
+        split->min(&diverged, 1);
+        if (std::isfinite(diverged))
+          throw RunError("body " + std::to_string(long(diverged)) + " has a non-finite velocity: the solver diverged");
+        split->sum(power, 3);
+        double least[1] = {-fastest};
+        split->min(least, 1);
+        fastest = -least[0];
+        // The ghosts' end states from their owners: their contacts' gaps, powers and checks.
+        for (const unsigned int b : split->send_states(system))
+          {
+            const RigidBody      &body = system.bodies[b];
+            const Eigen::Vector3d v(body.velocity.x(), body.velocity.y(), body.spin);
+            state.velocity[b] = v;
+            v_mid_of[b]       = 0.5 * (v_begin[b] + v);
+          }
+      }
+    report.power_external += power[0];
+    report.power_contacts += power[1];
+    report.power_free += power[2];
     return fastest;
   }
 
@@ -731,8 +825,25 @@ namespace tribo::dem
               mover       = name;
             }
         };
+        long farthest_body = -1;
         for (std::size_t b = 0; b < system.bodies.size(); ++b)
-          consider(v_begin[b].head<2>(), system.bodies[b].velocity, "body " + std::to_string(b));
+          if (advances(b))
+            {
+              const double before = farthest;
+              consider(v_begin[b].head<2>(), system.bodies[b].velocity, "body " + std::to_string(b));
+              if (farthest > before)
+                farthest_body = long(b);
+            }
+        double mover_record[4] = {double(farthest_body), start_speed, end_speed, farthest};
+        take_largest(farthest, mover_record, 4);
+        if (split_state())
+          {
+            farthest_body = long(mover_record[0]);
+            start_speed   = mover_record[1];
+            end_speed     = mover_record[2];
+            farthest      = mover_record[3];
+            mover         = "body " + std::to_string(farthest_body);
+          }
         for (std::size_t k = 0; k < node_v_end.size() && k < node_v_begin.size(); ++k)
           consider(node_v_begin[k], node_v_end[k], "a node of a deformable first body");
         const bool         by_nlgs = report.solver.solved_by_nlgs;

@@ -135,12 +135,26 @@ namespace tribo::dem
     /// held in shares, this process detects, solves and measures only its own contacts:
     /// - the solver gets them with the state's free velocities, without their warm-start
     ///   impulses (it adds every process's: dem/parallel/solve_across_ranks.h);
-    /// - the contact forces on the bodies (and on the boundary bodies' nodes) are summed over
-    ///   the processes, and every body's end velocity v_free + h M^-1 F comes from that sum,
-    ///   so that every process updates every body with the same bits;
-    /// - the StepReport's counts, epsilon and worst overlaps are over every process's contacts;
+    /// - the state is split (dem/engine/contact_split.h): this process advances the grains it
+    ///   owns and the replicated walls, from the contact forces summed on their owners
+    ///   (ContactSplit::sum_on_owners; the boundary bodies' node impulses summed over every
+    ///   process, which all advance them), sends their states to the processes that hold
+    ///   them as ghosts, and its copies of the other grains are stale until make_whole();
+    /// - the StepReport's counts, epsilon, worst overlaps, powers, kinetic energy and fastest
+    ///   speed are over every process's contacts and bodies, and so are the decisions to take
+    ///   a step again;
     /// - contacts() and contact_power() are this process's share (holds_every_contact()).
     void use_split(std::shared_ptr<ContactSplit> among) { split = std::move(among); }
+    /// Whether this process counts @p body in a sum over the processes (every body, unless
+    /// the state is split: then the grains it owns, and the walls on one process).
+    bool counts(unsigned int body) const { return !split_state() || split->counts(body); }
+    /// Collective on a split: every body's current state in @p system on every process (for
+    /// the outputs and checkpoints; a split state stays split). Nothing without a split.
+    void make_whole(ParticleSystem &system) const
+    {
+      if (split)
+        split->make_whole(system);
+    }
     /// False when the last step's contacts() are this process's share only.
     bool holds_every_contact() const { return !own_share; }
     /// Collective on a split: @p values summed over the processes when the last step was
@@ -235,15 +249,27 @@ namespace tribo::dem
     void predict(const ParticleSystem &system, double h);
     /// Disc pairs, and the half-discs of the attached boundary bodies (after their own
     /// predictions), closer than the detection distance at the predicted configuration, into found.
-    void detect(const ParticleSystem &system, double h, StepReport &report);
+    /// With a split state that must cut its bands again, the state is made whole first.
+    void detect(ParticleSystem &system, double h, StepReport &report);
     /// The local problems of found into current: arms (rows of H), own Delassus blocks,
     /// law terms, free local velocities, warm-start impulses applied to state.
     void set_up_local_problems(const ParticleSystem &system, double h, StepReport &report);
     /// body_force (and node_impulse, every attached body's nodes) from the contacts' impulses.
     void sum_contact_forces(double h);
-    /// On a step held in shares: body_force and node_impulse summed over the processes
-    /// (update_bodies() then puts every body's end velocity into state too).
+    /// On a step held in shares: body_force summed on the bodies' owners and node_impulse
+    /// over the processes (update_bodies() then puts the held bodies' end velocities into
+    /// state too).
     void join_shares();
+    /// Whether the state is split over the processes (ContactSplit::held()).
+    bool split_state() const { return split && split->held(); }
+    /// Whether this process advances @p body (every body, unless the state is split).
+    bool advances(unsigned int body) const { return !split_state() || split->advances(body); }
+    /// With a split state: @p values (@p n doubles) of the process whose @p key is the largest,
+    /// on every process (collective). Nothing otherwise.
+    void take_largest(double key, double *values, std::size_t n) const;
+    /// Each disc's centre at the predicted configuration (centres) and its motion estimate
+    /// until the next detection (disc_motion).
+    void place_discs(const ParticleSystem &system, double h);
     /// End velocities v_free + h M^-1 F_c, positions x_pred + theta h v, powers; returns the
     /// fastest body's speed (m/s). Throws RunError on a non-finite velocity.
     double update_bodies(ParticleSystem &system, double h, StepReport &report);
@@ -282,8 +308,8 @@ namespace tribo::dem
     /// that step() catches to take it again in more sub-steps, when a disc ended the step
     /// farther than r_min / 4 plus the detection distance from where its contact detection's
     /// motion estimate (disc_motion, any fraction of it) put it: a grain the solve launched may
-    /// then have closed a pair that detection did not see. Every process of a split updates
-    /// every body with the same bits, so they agree without a reduction.
+    /// then have closed a pair that detection did not see. Collective with a split state (the
+    /// worst disc over every process's).
     void check_foresight(const ParticleSystem &system, double h) const;
 
     double                   th;

@@ -7,14 +7,16 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 
 namespace tribo::dem::parallel
 {
-  BandSplit::BandSplit(MPI_Comm comm, double rebalance_at)
+  BandSplit::BandSplit(MPI_Comm comm, double margin, double rebalance_at)
     : comm(comm)
     , rank(dealii::Utilities::MPI::this_mpi_process(comm))
     , ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
     , rebalance_at(rebalance_at)
+    , margin(margin)
   {}
 
   std::optional<PairBand> BandSplit::own_band(const ParticleSystem &system)
@@ -22,6 +24,11 @@ namespace tribo::dem::parallel
     if (!partition)
       return std::nullopt;
     heights = disc_heights(system);
+    // The discs of grains this rank does not hold are stale: no pair of theirs is its own.
+    if (ownership)
+      for (std::size_t d = 0; d < heights.size(); ++d)
+        if (!ownership->holds(system.discs[d].body))
+          heights[d] = std::numeric_limits<double>::quiet_NaN();
     return PairBand{partition->cut[rank], partition->cut[rank + 1], &heights};
   }
 
@@ -40,11 +47,14 @@ namespace tribo::dem::parallel
           }
         if (total < std::uint64_t(min_contacts_per_rank) * ranks || double(largest) * ranks > rebalance_at * double(total))
           {
+            // The ownership stays until the caller has made the state whole (make_whole()).
             partition.reset();
             return last = Share::search_all;
           }
         return last = Share::own;
       }
+    // Every pair: the state is whole on every rank.
+    ownership.reset();
     if (pairs.size() < std::size_t(min_contacts_per_rank) * ranks)
       {
         partition.reset();
@@ -56,6 +66,8 @@ namespace tribo::dem::parallel
       y[i] = 0.5 * (heights[pairs[i].disc[0]] + heights[pairs[i].disc[1]]);
     partition = BandPartition::balanced(y, ranks);
     ++n_cuts;
+    ownership.emplace(comm, margin);
+    ownership->start(system, *partition);
     std::size_t kept = 0;
     for (std::size_t i = 0; i < pairs.size(); ++i)
       if (partition->band_of(y[i]) == rank)
@@ -77,6 +89,24 @@ namespace tribo::dem::parallel
   void BandSplit::min(double *values, std::size_t n) const
   {
     MPI_Allreduce(MPI_IN_PLACE, values, static_cast<int>(n), MPI_DOUBLE, MPI_MIN, comm);
+  }
+
+  void BandSplit::make_whole(ParticleSystem &system) const
+  {
+    if (ownership)
+      ownership->gather(system);
+  }
+
+  void BandSplit::keep()
+  {
+    kept = Kept{partition, ownership, last};
+  }
+
+  void BandSplit::go_back()
+  {
+    partition = kept->partition;
+    ownership = kept->ownership;
+    last      = kept->last;
   }
 
   std::vector<KeyedImpulse> BandSplit::all_gathered(const std::vector<KeyedImpulse> &mine) const

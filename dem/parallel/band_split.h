@@ -4,6 +4,7 @@
 
 #include "dem/engine/contact_split.h"
 #include "dem/parallel/band_partition.h"
+#include "dem/parallel/grain_ownership.h"
 
 #include <mpi.h>
 
@@ -28,8 +29,9 @@ namespace tribo::dem::parallel
   public:
     static constexpr unsigned int min_contacts_per_rank = 64;
 
-    /// Collective over @p comm; @p rebalance_at > 1.
-    explicit BandSplit(MPI_Comm comm, double rebalance_at = 1.05);
+    /// Collective over @p comm; @p margin (m): how far beyond its band a rank holds grains
+    /// (GrainOwnership); @p rebalance_at > 1.
+    BandSplit(MPI_Comm comm, double margin, double rebalance_at = 1.05);
 
     std::optional<PairBand> own_band(const ParticleSystem &system) override;
     Share                   divide(const ParticleSystem &system, std::vector<Contact> &pairs, bool all) override;
@@ -37,6 +39,18 @@ namespace tribo::dem::parallel
     void sum(double *values, std::size_t n) const override;
     void min(double *values, std::size_t n) const override;
     std::vector<KeyedImpulse> all_gathered(const std::vector<KeyedImpulse> &mine) const override;
+    const std::vector<unsigned int> *held() const override { return ownership ? &ownership->held() : nullptr; }
+    bool holds(unsigned int body) const override { return !ownership || ownership->holds(body); }
+    bool advances(unsigned int body) const override { return !ownership || ownership->advances(body); }
+    bool counts(unsigned int body) const override { return !ownership || ownership->counts(body); }
+    void sum_on_owners(std::vector<Eigen::Vector3d> &force) const override { ownership->sum_on_owners(force); }
+    const std::vector<unsigned int> &send_states(ParticleSystem &system) override { return ownership->send_states(system); }
+    void settle(const ParticleSystem &system) override { ownership->settle(system); }
+    void make_whole(ParticleSystem &system) const override;
+    void keep() override;
+    void go_back() override;
+    /// The grains' owners while the state is split (nullptr: whole).
+    const GrainOwnership *grain_ownership() const { return ownership ? &*ownership : nullptr; }
 
     /// True when the last divide() kept this rank's share (Share::own).
     bool holds_share() const { return last == Share::own; }
@@ -51,6 +65,19 @@ namespace tribo::dem::parallel
     unsigned int                 rank, ranks;
     double                       rebalance_at;
     std::optional<BandPartition> partition;
+    /// Who owns and holds which grain while this rank holds a share (Share::own); its margin:
+    /// 2 r_max + the detection distance beyond the band (a pair's reach from its midpoint,
+    /// with the disc motions' widening) plus r_max for a step's motion.
+    std::optional<GrainOwnership> ownership;
+    double                        margin;
+    /// keep()'s copy of the partition, the ownership and the last share.
+    struct Kept
+    {
+      std::optional<BandPartition>  partition;
+      std::optional<GrainOwnership> ownership;
+      Share                         last;
+    };
+    std::optional<Kept> kept;
     std::vector<double>          heights; ///< of the discs at the last own_band() or recut, m
     Share                        last   = Share::whole;
     unsigned long                n_cuts = 0;

@@ -1,12 +1,12 @@
 #include "dem/parallel/grain_ownership.h"
 
 #include "dem/parallel/all_gather.h"
-#include "dem/parallel/rank_problem.h"
 
 #include <boost/serialization/vector.hpp>
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <map>
 
 namespace tribo::dem::parallel
@@ -16,6 +16,17 @@ namespace tribo::dem::parallel
     /// Doubles per grain's state in a message: serial body number, x, y, angle, vx, vy, spin.
     constexpr std::size_t state_width = 7;
   } // namespace
+
+  std::vector<bool> grains_of(const ParticleSystem &system)
+  {
+    std::vector<unsigned int> discs(system.bodies.size(), 0);
+    for (const Disc &d : system.discs)
+      ++discs[d.body];
+    std::vector<bool> grain(system.bodies.size());
+    for (std::size_t b = 0; b < grain.size(); ++b)
+      grain[b] = discs[b] == 1;
+    return grain;
+  }
 
   GrainOwnership::GrainOwnership(MPI_Comm comm, double margin)
     : comm(comm)
@@ -55,31 +66,25 @@ namespace tribo::dem::parallel
     number(system);
   }
 
-  void GrainOwnership::exchange(ParticleSystem &system)
+  const std::vector<unsigned int> &GrainOwnership::send_states(ParticleSystem &system)
   {
-    // The owners' states to the ranks that hold them as ghosts from now on.
+    // To the ranks that hold each owned grain (holders, by body) and to those whose widened
+    // band holds its new centre.
     std::map<unsigned int, std::vector<double>> out;
+    auto                                        held_by = holders.begin();
     for (const unsigned int b : owned_grains)
       {
-        const RigidBody &body = system.bodies[b];
-        for (const unsigned int s : ghost_ranks(body.position.y()))
+        const RigidBody          &body = system.bodies[b];
+        std::vector<unsigned int> to   = ghost_ranks(body.position.y());
+        for (; held_by != holders.end() && held_by->first == b; ++held_by)
+          if (std::find(to.begin(), to.end(), held_by->second) == to.end())
+            to.push_back(held_by->second);
+        for (const unsigned int s : to)
           out[s].insert(out[s].end(), {double(b), body.position.x(), body.position.y(), body.angle,
                                        body.velocity.x(), body.velocity.y(), body.spin});
       }
-    const auto in = dealii::Utilities::MPI::some_to_some(comm, out);
-
-    // What this rank holds now: the grains it owned that are still in its widened band, and
-    // the ones received; each owned by the band of its centre.
-    for (const unsigned int b : held_bodies)
-      if (grain[b])
-        held_flag[b] = 0;
-    for (const unsigned int b : owned_grains)
-      {
-        const double y = system.bodies[b].position.y();
-        owner_of[b]    = bands.band_of(y);
-        held_flag[b]   = owner_of[b] == rank || (y >= bands.cut[rank] - margin && y < bands.cut[rank + 1] + margin);
-      }
-    for (const auto &[from, states] : in)
+    received.clear();
+    for (const auto &[from, states] : dealii::Utilities::MPI::some_to_some(comm, out))
       for (std::size_t i = 0; i + state_width <= states.size(); i += state_width)
         {
           const auto b    = static_cast<unsigned int>(states[i]);
@@ -88,9 +93,26 @@ namespace tribo::dem::parallel
           body.angle      = states[i + 3];
           body.velocity   = {states[i + 4], states[i + 5]};
           body.spin       = states[i + 6];
-          owner_of[b]     = bands.band_of(body.position.y());
-          held_flag[b]    = 1;
+          received.push_back(b);
         }
+    return received;
+  }
+
+  void GrainOwnership::settle(const ParticleSystem &system)
+  {
+    // The grains held or received are current here: each owned by the band of its centre,
+    // held when that is this band or its centre lies in the widened band.
+    const auto place = [&](unsigned int b) {
+      const double y = system.bodies[b].position.y();
+      owner_of[b]    = bands.band_of(y);
+      held_flag[b]   = owner_of[b] == rank || (y >= bands.cut[rank] - margin && y < bands.cut[rank + 1] + margin);
+    };
+    for (const unsigned int b : held_bodies)
+      if (grain[b])
+        place(b);
+    for (const unsigned int b : received)
+      place(b);
+    received.clear();
     number(system);
   }
 
@@ -115,11 +137,15 @@ namespace tribo::dem::parallel
         total += counts[s];
       }
     std::map<unsigned int, std::vector<double>> out;
+    holders.clear();
     for (const unsigned int b : owned_grains)
       {
         global[b] = first++;
         for (const unsigned int s : ghost_ranks(system.bodies[b].position.y()))
-          out[s].insert(out[s].end(), {double(b), double(global[b])});
+          {
+            out[s].insert(out[s].end(), {double(b), double(global[b])});
+            holders.emplace_back(b, s);
+          }
       }
     for (const auto &[from, numbers] : dealii::Utilities::MPI::some_to_some(comm, out))
       for (std::size_t i = 0; i + 2 <= numbers.size(); i += 2)
@@ -154,11 +180,11 @@ namespace tribo::dem::parallel
         per_body[b] = Eigen::Vector3d(replicated[k], replicated[k + 1], replicated[k + 2]), k += 3;
   }
 
-  void GrainOwnership::gather(ParticleSystem &system)
+  void GrainOwnership::gather(ParticleSystem &system) const
   {
     struct Record
     {
-      std::uint64_t body, global;
+      std::uint64_t body;
       double        state[6];
     };
     std::vector<Record> mine;
@@ -166,32 +192,16 @@ namespace tribo::dem::parallel
     for (const unsigned int b : owned_grains)
       {
         const RigidBody &body = system.bodies[b];
-        mine.push_back({b, global[b], {body.position.x(), body.position.y(), body.angle, body.velocity.x(),
+        mine.push_back({b, {body.position.x(), body.position.y(), body.angle, body.velocity.x(),
                                        body.velocity.y(), body.spin}});
       }
-    const std::vector<unsigned int> owners = [&] {
-      std::vector<unsigned int> o;
-      const std::vector<std::uint64_t> counts = dealii::Utilities::MPI::all_gather(comm, std::uint64_t(mine.size()));
-      for (unsigned int s = 0; s < ranks; ++s)
-        o.insert(o.end(), counts[s], s);
-      return o;
-    }();
-    const std::vector<Record> every = all_gathered(mine, comm);
-    for (std::size_t i = 0; i < every.size(); ++i)
+    for (const Record &r : all_gathered(mine, comm))
       {
-        const Record &r    = every[i];
-        RigidBody    &body = system.bodies[r.body];
+        RigidBody &body = system.bodies[r.body];
         body.position      = {r.state[0], r.state[1]};
         body.angle         = r.state[2];
         body.velocity      = {r.state[3], r.state[4]};
         body.spin          = r.state[5];
-        owner_of[r.body]   = owners[i];
-        global[r.body]     = r.global;
-        held_flag[r.body]  = 1;
       }
-    held_bodies.clear();
-    for (unsigned int b = 0; b < held_flag.size(); ++b)
-      if (held_flag[b])
-        held_bodies.push_back(b);
   }
 } // namespace tribo::dem::parallel

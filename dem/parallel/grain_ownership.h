@@ -16,10 +16,13 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace tribo::dem::parallel
 {
+  /// Whether each body is a grain (a body of one disc), not a clump (the walls).
+  std::vector<bool> grains_of(const ParticleSystem &system);
   class GrainOwnership
   {
   public:
@@ -35,11 +38,22 @@ namespace tribo::dem::parallel
     void start(const ParticleSystem &system, const BandPartition &bands);
 
     /// Collective, after each rank has advanced the grains it owns: each owned grain's state
-    /// (position, angle, velocity, spin) goes to every other rank whose band widened by the
-    /// margin holds its new centre, which overwrites its copy. Then every rank owns the grains
-    /// it holds whose centre lies in its band, and they are numbered again. The states of the
-    /// grains a rank does not hold are left as they were (stale).
-    void exchange(ParticleSystem &system);
+    /// (position, angle, velocity, spin) goes to the ranks that hold it as a ghost and to every
+    /// other rank whose band widened by the margin holds its new centre, which overwrite their
+    /// copies. Who owns and holds what is kept (a step that fails its checks is taken again
+    /// from its start, with the ownership it started with); the bodies received are returned.
+    const std::vector<unsigned int> &send_states(ParticleSystem &system);
+    /// Once the step stands: every rank owns the grains it holds or received whose centre
+    /// lies in its band, holds those in its widened band, and they are numbered again. A grain
+    /// that crossed into another band, that band's ghost until then, is owned there now. The
+    /// states of the grains a rank does not hold are left as they were (stale).
+    void settle(const ParticleSystem &system);
+    /// send_states() and settle().
+    void exchange(ParticleSystem &system)
+    {
+      send_states(system);
+      settle(system);
+    }
 
     /// Collective: @p per_body (one entry per body, e.g. the contact forces of this rank's
     /// contacts) summed where each body is advanced: a ghost grain's entry is added to its
@@ -48,11 +62,16 @@ namespace tribo::dem::parallel
     void sum_on_owners(std::vector<Eigen::Vector3d> &per_body) const;
 
     /// Collective: every grain's state from its owner onto every rank (the whole state again,
-    /// as at start(); the ownership is kept, and every grain is held until the next exchange()).
-    void gather(ParticleSystem &system);
+    /// as at start(), for the outputs; who owns and holds what is kept).
+    void gather(ParticleSystem &system) const;
 
     /// Whether this rank owns grain @p body (false for a replicated body).
     bool owns(unsigned int body) const { return grain[body] && held_flag[body] && owner_of[body] == rank; }
+    /// Whether this rank advances @p body: a grain it owns, or a replicated body (every rank).
+    bool advances(unsigned int body) const { return !grain[body] || owns(body); }
+    /// Whether this rank counts @p body in a sum over the ranks: a grain it owns, or a
+    /// replicated body on rank 0.
+    bool counts(unsigned int body) const { return grain[body] ? owns(body) : rank == 0; }
     /// Whether this rank's copy of @p body is current: an owned or ghost grain, or a replicated body.
     bool holds(unsigned int body) const { return held_flag[body] != 0; }
     /// The rank that owns held grain @p body.
@@ -78,7 +97,9 @@ namespace tribo::dem::parallel
     std::vector<char>          held_flag;    ///< per body
     std::vector<unsigned int>  owner_of;     ///< per held grain
     std::vector<std::uint64_t> global;       ///< per held grain
-    std::vector<unsigned int>  held_bodies, owned_grains;
+    std::vector<unsigned int>  held_bodies, owned_grains, received;
+    /// The ranks each owned grain's state was last sent to, (body, rank) by body: they hold it.
+    std::vector<std::pair<unsigned int, unsigned int>> holders;
     std::uint64_t              total = 0;
 
     /// The owned and held lists from held_flag and owner_of; the owned grains' global

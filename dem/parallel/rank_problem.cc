@@ -24,17 +24,6 @@ namespace tribo::dem::parallel
     }
   } // namespace
 
-  std::vector<bool> grains_of(const ParticleSystem &system)
-  {
-    std::vector<unsigned int> discs(system.bodies.size(), 0);
-    for (const Disc &d : system.discs)
-      ++discs[d.body];
-    std::vector<bool> grain(system.bodies.size());
-    for (std::size_t b = 0; b < grain.size(); ++b)
-      grain[b] = discs[b] == 1;
-    return grain;
-  }
-
   std::vector<double> disc_heights(const ParticleSystem &system)
   {
     std::vector<double> y(system.discs.size());
@@ -67,24 +56,39 @@ namespace tribo::dem::parallel
     /// @p p's bodies for its owned contacts, @p contacts[p.serial_contact[k]] (p.contacts
     /// not filled): the grains' global numbers, the local bodies and their state.
     void number_bodies(RankProblem &p, const ParticleSystem &system, const std::vector<Contact> &contacts,
-                       const BodyState &state, const BandPartition &bands, unsigned int rank)
+                       const BodyState &state, const BandPartition &bands, unsigned int rank,
+                       const GrainOwnership *ownership)
     {
       const std::size_t       n_bodies = system.bodies.size();
       const std::vector<bool> grain    = grains_of(system);
 
-      // Global numbers: the grains band by band, each band's in serial order.
-      std::vector<unsigned int> band(n_bodies, 0);
-      std::vector<std::uint64_t> count(bands.n_bands() + 1, 0);
-      for (std::size_t b = 0; b < n_bodies; ++b)
-        if (grain[b])
-          ++count[(band[b] = bands.band_of(system.bodies[b].position.y())) + 1];
-      for (unsigned int k = 0; k < bands.n_bands(); ++k)
-        count[k + 1] += count[k]; // count[k]: the first global number of band k
-      p.n_grains = count[bands.n_bands()];
+      // Global numbers: the grains band by band, each band's in serial order; with a split
+      // state, the ownership's (the same numbers, from the grains this rank holds).
+      std::vector<unsigned int>  band(n_bodies, 0);
       std::vector<std::uint64_t> global(n_bodies, 0);
-      for (std::size_t b = 0; b < n_bodies; ++b)
-        if (grain[b])
-          global[b] = count[band[b]]++;
+      if (ownership)
+        {
+          p.n_grains = ownership->n_grains();
+          for (const unsigned int b : ownership->held())
+            if (grain[b])
+              {
+                band[b]   = ownership->owner(b);
+                global[b] = ownership->global_number(b);
+              }
+        }
+      else
+        {
+          std::vector<std::uint64_t> count(bands.n_bands() + 1, 0);
+          for (std::size_t b = 0; b < n_bodies; ++b)
+            if (grain[b])
+              ++count[(band[b] = bands.band_of(system.bodies[b].position.y())) + 1];
+          for (unsigned int k = 0; k < bands.n_bands(); ++k)
+            count[k + 1] += count[k]; // count[k]: the first global number of band k
+          p.n_grains = count[bands.n_bands()];
+          for (std::size_t b = 0; b < n_bodies; ++b)
+            if (grain[b])
+              global[b] = count[band[b]]++;
+        }
 
       // The grains the owned contacts touch.
       std::vector<bool> touched(n_bodies, false);
@@ -95,7 +99,7 @@ namespace tribo::dem::parallel
       for (unsigned int b = 0; b < n_bodies; ++b)
         if (!grain[b])
           replicated.push_back(b);
-        else if (band[b] == rank)
+        else if (ownership ? ownership->owns(b) : band[b] == rank)
           owned.push_back(b);
         else if (touched[b])
           ghosts.push_back(b);
@@ -149,7 +153,7 @@ namespace tribo::dem::parallel
     for (std::size_t i = 0; i < contacts.size(); ++i)
       if ((contacts[i].on_boundary() ? top : bands.band_of(heights[i])) == rank)
         p.serial_contact.push_back(static_cast<unsigned int>(i));
-    number_bodies(p, system, contacts, state, bands, rank);
+    number_bodies(p, system, contacts, state, bands, rank, nullptr);
     p.contacts.resize(p.serial_contact.size());
     for (std::size_t k = 0; k < p.contacts.size(); ++k)
       to_local(p, p.contacts[k] = contacts[p.serial_contact[k]]);
@@ -157,12 +161,12 @@ namespace tribo::dem::parallel
   }
 
   RankProblem own_share(const ParticleSystem &system, std::vector<Contact> &contacts, const BodyState &state,
-                        const BandPartition &bands, unsigned int rank)
+                        const BandPartition &bands, unsigned int rank, const GrainOwnership *ownership)
   {
     RankProblem p;
     p.serial_contact.resize(contacts.size());
     std::iota(p.serial_contact.begin(), p.serial_contact.end(), 0u);
-    number_bodies(p, system, contacts, state, bands, rank);
+    number_bodies(p, system, contacts, state, bands, rank, ownership);
     p.contacts.swap(contacts);
     for (Contact &c : p.contacts)
       to_local(p, c);

@@ -7,6 +7,7 @@
 #include "dem/engine/contact.h"
 #include "dem/engine/particle_system.h"
 #include "dem/parallel/band_partition.h"
+#include "dem/parallel/grain_ownership.h"
 
 #include <cstdint>
 #include <vector>
@@ -42,8 +43,6 @@ namespace tribo::dem::parallel
     unsigned int n_replicated() const { return static_cast<unsigned int>(serial_body.size()) - n_owned - n_ghost; }
   };
 
-  /// Whether each body is a grain (a body of one disc), not a clump (the walls).
-  std::vector<bool> grains_of(const ParticleSystem &system);
   /// The height of each disc's centre, m (a grain's: its body's position).
   std::vector<double> disc_heights(const ParticleSystem &system);
   /// The height of each contact's midpoint between its two disc centres (a half-disc
@@ -64,8 +63,10 @@ namespace tribo::dem::parallel
   /// Rank @p rank's problem of its own @p contacts (all of them in its band: a step held in
   /// shares, dem/parallel/band_split.h), which it takes over without a copy (@p contacts is
   /// left empty); give_back() returns them, with their impulses, in serial numbers.
+  /// With @p ownership (a split state, dem/parallel/grain_ownership.h), the grains' owners
+  /// and global numbers are its own: this rank's copies of the grains it does not hold are stale.
   RankProblem own_share(const ParticleSystem &system, std::vector<Contact> &contacts, const BodyState &state,
-                        const BandPartition &bands, unsigned int rank);
+                        const BandPartition &bands, unsigned int rank, const GrainOwnership *ownership = nullptr);
   /// @p p's contacts back into @p contacts (the one own_share() emptied), their bodies in
   /// serial numbers (a half-disc contact's unused side 0 naming its grain).
   void give_back(RankProblem &p, std::vector<Contact> &contacts);

@@ -74,7 +74,11 @@ class Ranks(TempDirTestCase):
         return subprocess.run(mpirun(ranks, args), cwd=self.tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                               universal_newlines=True, timeout=timeout, env=MPI_ENV)
 
-    def assert_within_errors(self, a, b, name, errors=2):
+    def assert_within_errors(self, a, b, name, errors=3):
+        """Two runs' means within @p errors combined standard errors: two trajectories apart
+        from the first steps' round-off, so a realisation falls outside 2 errors one time in
+        twenty for each quantity (four quantities: more than one run in ten), outside 3 one
+        time in 370."""
         ra, rb = a["results"], b["results"]
         mean = name + "_mean" if name + "_mean" in ra else name
         combined = math.hypot(ra[name + "_stderr"], rb[name + "_stderr"])
@@ -92,9 +96,12 @@ class Ranks(TempDirTestCase):
         return s
 
     def test_two_ranks_give_the_serial_friction_and_one_set_of_outputs(self):
-        r = run(["run", "case.prm", "--output", "one", "--quiet"], self.tmp, timeout=300)
+        # 20 000 steps: over the case's 8000 a realisation's mu moves by 0.02 (0.1087 +/- 0.0035
+        # against 0.1277 +/- 0.0050 serial), over 20 000 by 0.004.
+        longer = ["--set", "Simulation/End time=4e-5"]
+        r = run(["run", "case.prm", "--output", "one", "--quiet"] + longer, self.tmp, timeout=300)
         self.assertEqual(r.returncode, 0, r.stderr)
-        r = self.run_ranks(2, ["run", "case.prm", "--output", "two"])
+        r = self.run_ranks(2, ["run", "case.prm", "--output", "two"] + longer)
         self.assertEqual(r.returncode, 0, r.stderr)
         # One log: rank 0's, on the terminal and in log.txt.
         self.assertEqual(r.stdout.count("tribo run case.prm -> two"), 1, r.stdout)
@@ -105,7 +112,7 @@ class Ranks(TempDirTestCase):
         self.assertEqual(sorted(os.listdir(os.path.join(self.tmp, "one"))),
                          sorted(os.listdir(os.path.join(self.tmp, "two"))))
         one, two = self.assert_solved_to_target("one"), self.assert_solved_to_target("two")
-        self.assertEqual(two["steps"], 8000)
+        self.assertEqual(two["steps"], 20000)
         for name in ("mu", "sigma_xy", "solid_fraction", "power_balance_ratio"):
             self.assert_within_errors(one, two, name)
         # The split's own cost is timed as a part of the solve's, and only where there is a split.
