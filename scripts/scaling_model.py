@@ -17,15 +17,15 @@ E = T_1 / (P T_P); the solve's is E divided by sweeps(P) / sweeps(1), measured o
 ranks (1.011-1.017 on two, 1.026 on four). A band must be at least two grains high (a contact
 then joins two neighbouring bands at most): P <= H / 2.
 
-A step (docs/scaling.md, "How far this design goes"): the sweeps' share of the one-core step
+A step (docs/scaling.md, "The state split"): the sweeps' share of the one-core step
 split as above, and a fraction f of it done whole on every rank (the passes over every body and
-disc: predicting them, their centres and motions):
+disc: predicting them, their centres, motions and heights):
     E_step = 1 / ((1 - f) / E + f P).
 Each rank updates only its own grains, and the ghosts' forces and states cross the band
 boundaries once a step (the sweeps' exchange, once instead of some sixty times: left out).
 It leaves out what the measured two ranks add beyond the sweep model (waiting for the slower
-rank, each rank's set-up of its share): it gives 0.98 for two ranks here at 16 000 and 64 000
-grains, where they measure 0.82-0.89.
+rank, each rank's set-up of its share): it gives 0.99 for two ranks here at 16 000 and 64 000
+grains, where they measure 0.78.
 """
 import math
 
@@ -37,10 +37,11 @@ CHECK_INTERVAL = 10
 HERE = ("this machine (ping-pong, shared memory)", 0.49e-6, 5.5e9)
 NETWORKS = [HERE, ("InfiniBand HDR (typical)", 1.5e-6, 12e9), ("10 Gb Ethernet (typical)", 20e-6, 1.1e9)]
 MEASURED_T2 = {16_000: 0.449e-3, 64_000: 2.05e-3}  # s per sweep on two ranks (warm, 1e-3)
-# A step at 64 000 grains, APGS 1e-3 (docs/scaling.md, "Whole runs", commit 6925331): one core,
-# the mean of two runs, and the part every rank does whole (instrumented once on two ranks:
-# predicting every body 0.85 ms, every disc's centre and motion 1.35 ms).
-WHOLE_FRACTION = (0.85e-3 + 1.35e-3) / 0.366
+# A step at 64 000 grains, APGS 1e-3 (docs/scaling.md, "Whole runs"): one core 376 ms, and the
+# passes every rank makes over every body and disc (instrumented once on two ranks: predicting
+# the bodies 1.3 ms, the discs' centres and motions 1.6, their heights 0.8, keeping the
+# ownership for a retake 0.2).
+WHOLE_FRACTION = 3.9e-3 / 0.376
 
 
 def sweep_time(n, p, thickness, alpha, beta, t_c):

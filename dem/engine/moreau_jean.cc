@@ -308,11 +308,13 @@ namespace tribo::dem
     // The next step's warm start, once the step stands (a step taken again starts from the last).
     previous_impulse.assign(next_impulse);
     report.kinetic_energy = 0;
-    for (std::size_t b = 0; b < system.bodies.size(); ++b)
-      if (counts(b))
-        report.kinetic_energy += system.bodies[b].kinetic_energy();
-    if (split_state())
+    if (!split_state())
+      report.kinetic_energy = system.kinetic_energy();
+    else
       {
+        for (const unsigned int b : *split->held())
+          if (split->counts(b))
+            report.kinetic_energy += system.bodies[b].kinetic_energy();
         split->sum(&report.kinetic_energy, 1);
         split->settle(system);
       }
@@ -610,8 +612,11 @@ namespace tribo::dem
     // The powers over the bodies this process counts: external, contacts, on the free bodies.
     double power[3] = {0, 0, 0};
     double diverged = INFINITY; // the least body with a non-finite velocity, with a split state
-    for (std::size_t b = 0; b < nb; ++b)
+    // With a split state, the bodies held here (the others are not advanced here).
+    const std::vector<unsigned int> *held = split_state() ? split->held() : nullptr;
+    for (std::size_t i = 0, n = held ? held->size() : nb; i < n; ++i)
       {
+        const std::size_t b = held ? (*held)[i] : i;
         if (!advances(b))
           continue;
         RigidBody &body = system.bodies[b];

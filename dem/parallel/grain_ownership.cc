@@ -35,15 +35,6 @@ namespace tribo::dem::parallel
     , margin(margin)
   {}
 
-  std::vector<unsigned int> GrainOwnership::ghost_ranks(double y) const
-  {
-    std::vector<unsigned int> to;
-    for (unsigned int s = 0; s < bands.n_bands(); ++s)
-      if (s != rank && y >= bands.cut[s] - margin && y < bands.cut[s + 1] + margin)
-        to.push_back(s);
-    return to;
-  }
-
   void GrainOwnership::start(const ParticleSystem &system, const BandPartition &partition)
   {
     bands = partition;
@@ -74,14 +65,16 @@ namespace tribo::dem::parallel
     auto                                        held_by = holders.begin();
     for (const unsigned int b : owned_grains)
       {
-        const RigidBody          &body = system.bodies[b];
-        std::vector<unsigned int> to   = ghost_ranks(body.position.y());
+        const RigidBody &body  = system.bodies[b];
+        const auto       state = {double(b), body.position.x(), body.position.y(), body.angle,
+                                  body.velocity.x(),     body.velocity.y(),   body.spin};
+        const auto [first, last] = widened_bands(body.position.y());
+        for (unsigned int s = first; s <= last; ++s)
+          if (s != rank)
+            out[s].insert(out[s].end(), state);
         for (; held_by != holders.end() && held_by->first == b; ++held_by)
-          if (std::find(to.begin(), to.end(), held_by->second) == to.end())
-            to.push_back(held_by->second);
-        for (const unsigned int s : to)
-          out[s].insert(out[s].end(), {double(b), body.position.x(), body.position.y(), body.angle,
-                                       body.velocity.x(), body.velocity.y(), body.spin});
+          if (held_by->second < first || held_by->second > last)
+            out[held_by->second].insert(out[held_by->second].end(), state);
       }
     received.clear();
     for (const auto &[from, states] : dealii::Utilities::MPI::some_to_some(comm, out))
@@ -140,12 +133,14 @@ namespace tribo::dem::parallel
     holders.clear();
     for (const unsigned int b : owned_grains)
       {
-        global[b] = first++;
-        for (const unsigned int s : ghost_ranks(system.bodies[b].position.y()))
-          {
-            out[s].insert(out[s].end(), {double(b), double(global[b])});
-            holders.emplace_back(b, s);
-          }
+        global[b]                  = first++;
+        const auto [lowest, highest] = widened_bands(system.bodies[b].position.y());
+        for (unsigned int s = lowest; s <= highest; ++s)
+          if (s != rank)
+            {
+              out[s].insert(out[s].end(), {double(b), double(global[b])});
+              holders.emplace_back(b, s);
+            }
       }
     for (const auto &[from, numbers] : dealii::Utilities::MPI::some_to_some(comm, out))
       for (std::size_t i = 0; i + 2 <= numbers.size(); i += 2)

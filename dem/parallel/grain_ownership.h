@@ -65,6 +65,8 @@ namespace tribo::dem::parallel
     /// as at start(), for the outputs; who owns and holds what is kept).
     void gather(ParticleSystem &system) const;
 
+    /// Whether @p body is a grain (a body of one disc), not a replicated clump.
+    bool is_grain(unsigned int body) const { return grain[body]; }
     /// Whether this rank owns grain @p body (false for a replicated body).
     bool owns(unsigned int body) const { return grain[body] && held_flag[body] && owner_of[body] == rank; }
     /// Whether this rank advances @p body: a grain it owns, or a replicated body (every rank).
@@ -85,8 +87,12 @@ namespace tribo::dem::parallel
     const std::vector<unsigned int> &owned() const { return owned_grains; }
     /// Grains on all ranks.
     std::uint64_t n_grains() const { return total; }
-    /// The ranks other than this one whose band widened by the margin holds height @p y.
-    std::vector<unsigned int> ghost_ranks(double y) const;
+    /// The bands whose band widened by the margin holds height @p y: first to last (this
+    /// rank's among them when it holds the grain).
+    std::pair<unsigned int, unsigned int> widened_bands(double y) const
+    {
+      return {bands.band_of(y - margin), bands.band_of(y + margin)};
+    }
 
   private:
     MPI_Comm                   comm;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <utility>
 
 namespace tribo::dem::parallel
 {
@@ -59,25 +60,31 @@ namespace tribo::dem::parallel
                        const BodyState &state, const BandPartition &bands, unsigned int rank,
                        const GrainOwnership *ownership)
     {
-      const std::size_t       n_bodies = system.bodies.size();
-      const std::vector<bool> grain    = grains_of(system);
-
-      // Global numbers: the grains band by band, each band's in serial order; with a split
-      // state, the ownership's (the same numbers, from the grains this rank holds).
-      std::vector<unsigned int>  band(n_bodies, 0);
-      std::vector<std::uint64_t> global(n_bodies, 0);
+      const std::size_t n_bodies = system.bodies.size();
+      std::vector<unsigned int> owned, ghosts, replicated;
+      std::vector<std::uint64_t> global_of; // without an ownership: every body's global number
+      const auto global = [&](unsigned int b) { return ownership ? ownership->global_number(b) : global_of[b]; };
       if (ownership)
         {
+          // The ownership's grains and numbers (this rank's copies of the others are stale):
+          // its owned grains, the grains the owned contacts touch beyond them, the walls.
           p.n_grains = ownership->n_grains();
+          owned      = ownership->owned();
           for (const unsigned int b : ownership->held())
-            if (grain[b])
-              {
-                band[b]   = ownership->owner(b);
-                global[b] = ownership->global_number(b);
-              }
+            if (!ownership->is_grain(b))
+              replicated.push_back(b);
+          std::vector<char> seen(n_bodies, 0);
+          for (const unsigned int i : p.serial_contact)
+            for (int s = contacts[i].on_boundary() ? 1 : 0; s < 2; ++s)
+              if (const unsigned int b = contacts[i].body[s];
+                  ownership->is_grain(b) && !ownership->owns(b) && !std::exchange(seen[b], 1))
+                ghosts.push_back(b);
         }
       else
         {
+          // Global numbers: the grains band by band, each band's in serial order.
+          const std::vector<bool>    grain = grains_of(system);
+          std::vector<unsigned int>  band(n_bodies, 0);
           std::vector<std::uint64_t> count(bands.n_bands() + 1, 0);
           for (std::size_t b = 0; b < n_bodies; ++b)
             if (grain[b])
@@ -85,25 +92,24 @@ namespace tribo::dem::parallel
           for (unsigned int k = 0; k < bands.n_bands(); ++k)
             count[k + 1] += count[k]; // count[k]: the first global number of band k
           p.n_grains = count[bands.n_bands()];
+          global_of.assign(n_bodies, 0);
           for (std::size_t b = 0; b < n_bodies; ++b)
             if (grain[b])
-              global[b] = count[band[b]]++;
+              global_of[b] = count[band[b]]++;
+          // The grains the owned contacts touch.
+          std::vector<bool> touched(n_bodies, false);
+          for (const unsigned int i : p.serial_contact)
+            for (int s = contacts[i].on_boundary() ? 1 : 0; s < 2; ++s)
+              touched[contacts[i].body[s]] = true;
+          for (unsigned int b = 0; b < n_bodies; ++b)
+            if (!grain[b])
+              replicated.push_back(b);
+            else if (band[b] == rank)
+              owned.push_back(b);
+            else if (touched[b])
+              ghosts.push_back(b);
         }
-
-      // The grains the owned contacts touch.
-      std::vector<bool> touched(n_bodies, false);
-      for (const unsigned int i : p.serial_contact)
-        for (int s = contacts[i].on_boundary() ? 1 : 0; s < 2; ++s)
-          touched[contacts[i].body[s]] = true;
-      std::vector<unsigned int> owned, ghosts, replicated;
-      for (unsigned int b = 0; b < n_bodies; ++b)
-        if (!grain[b])
-          replicated.push_back(b);
-        else if (ownership ? ownership->owns(b) : band[b] == rank)
-          owned.push_back(b);
-        else if (touched[b])
-          ghosts.push_back(b);
-      const auto by_global = [&](unsigned int a, unsigned int b) { return global[a] < global[b]; };
+      const auto by_global = [&](unsigned int a, unsigned int b) { return global(a) < global(b); };
       std::sort(owned.begin(), owned.end(), by_global);
       std::sort(ghosts.begin(), ghosts.end(), by_global);
       p.n_owned = static_cast<unsigned int>(owned.size());
@@ -122,7 +128,7 @@ namespace tribo::dem::parallel
           p.state.velocity.push_back(state.velocity[b]);
           p.state.inverse_mass.push_back(state.inverse_mass[b]);
           if (l < p.n_owned + p.n_ghost)
-            p.global_grain.push_back(global[b]);
+            p.global_grain.push_back(global(b));
         }
       if (rank == bands.n_bands() - 1)
         {
