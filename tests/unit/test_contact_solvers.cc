@@ -311,6 +311,10 @@ TEST(ContactSolvers, LawResidualWithNothingLoadedReadsAgainstTheContactsVelociti
   EXPECT_EQ(relative_law_residual(0, 0, 0), 0.0);
   EXPECT_DOUBLE_EQ(relative_law_residual(1e-3, 2.0, 1e-9), 5e-4); // loaded: the mean impulse
   EXPECT_DOUBLE_EQ(relative_law_residual(1e-15, 1e-16, 1e-9), 10.0); // loaded, however little
+  // ... down to 1e-12 of the velocity scale; below, round-off on contacts that carry nothing
+  // (2.6e-31 N s/m seen on two ranks): nothing loaded.
+  EXPECT_DOUBLE_EQ(relative_law_residual(1e-30, 2e-21, 1e-9), 5e-10);
+  EXPECT_DOUBLE_EQ(relative_law_residual(4.7e-35, 2.6e-31, 1e-9), 4.7e-26);
 }
 
 TEST(ContactSolvers, ApgsPolishesOneWrongContactWithoutAWholeSweep)

@@ -453,6 +453,15 @@ namespace
         EXPECT_NEAR(split_system.bodies[b].position.y(), serial.bodies[b].position.y(), 1e-9 * 1e-6 * fastest) << b;
       }
     EXPECT_NEAR(split_report.power_contacts, serial_report.power_contacts, 1e-6 * std::abs(serial_report.power_contacts));
+    // Each contact's power at the mid-step velocities, a ghost's from its owner's end state.
+    double split_power = 0, serial_power = 0;
+    for (const double p : many.contact_power())
+      split_power += p;
+    for (const double p : one.contact_power())
+      serial_power += p;
+    split_power = dealii::Utilities::MPI::sum(split_power, world());
+    EXPECT_NEAR(split_power, serial_power, 1e-6 * std::abs(serial_power));
+    EXPECT_NEAR(split_report.epsilon, serial_report.epsilon, 1e-6 * std::abs(serial_report.epsilon));
 
     // A checkpoint's warm start (Simulation::prepare_checkpoint gathers it first): every
     // rank's loaded contacts once, with their impulses bit for bit, on every rank.
