@@ -20,8 +20,13 @@ namespace tribo::dem::parallel
   /// - the ranks' counts are compared (one MPI_Allgather of a count): when the largest
   ///   exceeds @p rebalance_at times the mean, every rank detects every pair and the bands
   ///   are cut again at the quantiles of the contacts' heights (BandPartition::balanced);
+  /// - while a rank holds its share (Share::own), the state is split too (GrainOwnership,
+  ///   with the margin given): the rank owns the grains of its band and holds its ghosts,
+  ///   its copies of the other grains stale (their discs' heights NaN in own_band(), so that
+  ///   no pair of theirs is found); the whole state is gathered (make_whole()) before every
+  ///   pair is detected;
   /// - with fewer than min_contacts_per_rank contacts per rank, every rank holds every
-  ///   contact (Share::whole), and the next step detects every pair again.
+  ///   contact and body (Share::whole), and the next step detects every pair again.
   /// Sums over the ranks are reduced on rank 0 and broadcast, so that every rank has the
   /// same bits (an all-reduce may add in a different order on each).
   class BandSplit : public ContactSplit

@@ -1,7 +1,8 @@
 #pragma once
 /// @file The contact solver of a case run on several MPI ranks (`mpirun -np N tribo run`):
-/// every rank holds every body and updates it (MoreauJean with a BandSplit,
-/// dem/parallel/band_split.h); each detects and solves only the contacts of its band, by
+/// each rank advances the grains of its band (MoreauJean with a BandSplit,
+/// dem/parallel/band_split.h, its state split by GrainOwnership); each detects and solves only
+/// the contacts of its band, by
 /// DistributedApgs (dem/parallel/distributed_apgs.h) or, for Solver/Method = nlgs, by
 /// DistributedGaussSeidel's plain sweeps stopped by NLGS's own test.
 
