@@ -38,9 +38,9 @@ HERE = ("this machine (ping-pong, shared memory)", 0.49e-6, 5.5e9)
 NETWORKS = [HERE, ("InfiniBand HDR (typical)", 1.5e-6, 12e9), ("10 Gb Ethernet (typical)", 20e-6, 1.1e9)]
 MEASURED_T2 = {16_000: 0.449e-3, 64_000: 2.05e-3}  # s per sweep on two ranks (warm, 1e-3)
 # A step at 64 000 grains, APGS 1e-3 (docs/scaling.md, "Whole runs"): one core 376 ms, and the
-# passes every rank makes over every body and disc (instrumented once on two ranks: predicting
+# passes every rank made over every body and disc (instrumented once on two ranks: predicting
 # the bodies 1.3 ms, the discs' centres and motions 1.6, their heights 0.8, keeping the
-# ownership for a retake 0.2).
+# ownership for a retake 0.2), an upper bound since those passes take only the held bodies.
 WHOLE_FRACTION = 3.9e-3 / 0.376
 
 

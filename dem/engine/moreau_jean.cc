@@ -322,7 +322,7 @@ namespace tribo::dem
     return report;
   }
 
-  void MoreauJean::predict(const ParticleSystem &system, double h)
+  void MoreauJean::predict(const ParticleSystem &system, double h, bool every)
   {
     // Free velocities (imposed loads over the step) and the predicted configuration
     // x + (1 - theta) h v, where contacts are detected and their geometry taken.
@@ -333,9 +333,11 @@ namespace tribo::dem
     v_free.resize(nb);
     x_pred.resize(nb);
     angle_pred.resize(nb);
-    for (std::size_t b = 0; b < nb; ++b)
+    const std::vector<unsigned int> *held = split_state() && !every ? split->held() : nullptr;
+    for (std::size_t i = 0, n = held ? held->size() : nb; i < n; ++i)
       {
-        const RigidBody &body = system.bodies[b];
+        const std::size_t b    = held ? (*held)[i] : i;
+        const RigidBody  &body = system.bodies[b];
         v_begin[b]            = {body.velocity.x(), body.velocity.y(), body.spin};
         state.inverse_mass[b] = body.inverse_mass();
         Eigen::Vector3d v     = v_begin[b];
@@ -350,12 +352,16 @@ namespace tribo::dem
 
   }
 
-  void MoreauJean::place_discs(const ParticleSystem &system, double h)
+  void MoreauJean::place_discs(const ParticleSystem &system, double h, bool every)
   {
+    // With a split state, the discs of the bodies this process holds (the others' are stale).
+    const bool some = split_state() && !every;
     centres.resize(system.discs.size());
     for (std::size_t d = 0; d < system.discs.size(); ++d)
       {
         const Disc &disc = system.discs[d];
+        if (some && !split->holds(disc.body))
+          continue;
         centres[d] = system.wrap(x_pred[disc.body] + rotate(disc.offset, angle_pred[disc.body]));
       }
     // Each disc's motion until the next detection, estimated as lookahead steps at its
@@ -369,7 +375,9 @@ namespace tribo::dem
     disc_motion.resize(system.discs.size());
     for (std::size_t d = 0; d < system.discs.size(); ++d)
       {
-        const Disc            &disc   = system.discs[d];
+        const Disc &disc = system.discs[d];
+        if (some && !split->holds(disc.body))
+          continue;
         const Eigen::Vector3d  v      = v_begin[disc.body] + (v_free[disc.body] - v_begin[disc.body]) / lookahead;
         const Vec2             offset = rotate(disc.offset, angle_pred[disc.body]);
         disc_motion[d] = lookahead * h * Vec2(v.x() - v.z() * offset.y(), v.y() + v.z() * offset.x());
@@ -398,8 +406,8 @@ namespace tribo::dem
               {
                 // Every pair at the predicted configuration of the whole state.
                 split->make_whole(system);
-                predict(system, h);
-                place_discs(system, h);
+                predict(system, h, true);
+                place_discs(system, h, true);
               }
             detector.detect(system, centres, distance, threads, disc_motion, found);
             share = split->divide(system, found, true);

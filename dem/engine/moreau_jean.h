@@ -246,7 +246,8 @@ namespace tribo::dem
     // The phases of step(), in order (see the file comment).
     /// Free velocities v_free = v + h M^-1 F_ext and the predicted configuration
     /// x + (1 - theta) h v (x_pred, angle_pred), into state and the scratch below.
-    void predict(const ParticleSystem &system, double h);
+    /// With a split state only the bodies this process holds, unless @p every.
+    void predict(const ParticleSystem &system, double h, bool every = false);
     /// Disc pairs, and the half-discs of the attached boundary bodies (after their own
     /// predictions), closer than the detection distance at the predicted configuration, into found.
     /// With a split state that must cut its bands again, the state is made whole first.
@@ -269,7 +270,7 @@ namespace tribo::dem
     void take_largest(double key, double *values, std::size_t n) const;
     /// Each disc's centre at the predicted configuration (centres) and its motion estimate
     /// until the next detection (disc_motion).
-    void place_discs(const ParticleSystem &system, double h);
+    void place_discs(const ParticleSystem &system, double h, bool every = false);
     /// End velocities v_free + h M^-1 F_c, positions x_pred + theta h v, powers; returns the
     /// fastest body's speed (m/s). Throws RunError on a non-finite velocity.
     double update_bodies(ParticleSystem &system, double h, StepReport &report);

@@ -23,12 +23,16 @@ namespace tribo::dem::parallel
   {
     if (!partition)
       return std::nullopt;
-    heights = disc_heights(system);
-    // The discs of grains this rank does not hold are stale: no pair of theirs is its own.
-    if (ownership)
-      for (std::size_t d = 0; d < heights.size(); ++d)
-        if (!ownership->holds(system.discs[d].body))
-          heights[d] = std::numeric_limits<double>::quiet_NaN();
+    if (!ownership)
+      heights = disc_heights(system);
+    else
+      {
+        // The discs of grains this rank does not hold are stale: no pair of theirs is its own.
+        heights.resize(system.discs.size());
+        for (std::size_t d = 0; d < heights.size(); ++d)
+          heights[d] = ownership->holds(system.discs[d].body) ? disc_height(system, static_cast<unsigned int>(d))
+                                                              : std::numeric_limits<double>::quiet_NaN();
+      }
     return PairBand{partition->cut[rank], partition->cut[rank + 1], &heights};
   }
 

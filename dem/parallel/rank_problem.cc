@@ -6,14 +6,14 @@
 
 namespace tribo::dem::parallel
 {
+  double disc_height(const ParticleSystem &system, unsigned int d)
+  {
+    const Disc &disc = system.discs[d];
+    return disc.offset.x() == 0 && disc.offset.y() == 0 ? system.bodies[disc.body].position.y() : system.disc_centre(d).y();
+  }
+
   namespace
   {
-    /// Height of disc @p d's centre, m (a grain's without the rotation: the same value).
-    double disc_height(const ParticleSystem &system, unsigned int d)
-    {
-      const Disc &disc = system.discs[d];
-      return disc.offset.x() == 0 && disc.offset.y() == 0 ? system.bodies[disc.body].position.y() : system.disc_centre(d).y();
-    }
 
     /// Height of the midpoint of contact @p c's two disc centres, m; a half-disc contact's,
     /// its grain's.

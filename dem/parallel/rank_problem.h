@@ -43,6 +43,8 @@ namespace tribo::dem::parallel
     unsigned int n_replicated() const { return static_cast<unsigned int>(serial_body.size()) - n_owned - n_ghost; }
   };
 
+  /// The height of disc @p d's centre, m (a grain's: its body's position).
+  double disc_height(const ParticleSystem &system, unsigned int d);
   /// The height of each disc's centre, m (a grain's: its body's position).
   std::vector<double> disc_heights(const ParticleSystem &system);
   /// The height of each contact's midpoint between its two disc centres (a half-disc
