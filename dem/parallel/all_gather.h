@@ -1,10 +1,12 @@
 #pragma once
-/// @file Every rank's vector of plain records concatenated in rank order, on every rank.
+/// @file Every rank's vector of plain records concatenated in rank order, on every rank; and
+/// sums over the ranks with the same bits on every rank.
 
 #include <mpi.h>
 
 #include <deal.II/base/mpi.h>
 
+#include <cstddef>
 #include <type_traits>
 #include <vector>
 
@@ -24,5 +26,17 @@ namespace tribo::dem::parallel
     std::vector<T> all(std::size_t(offsets.back()) / sizeof(T));
     MPI_Allgatherv(mine.data(), bytes, MPI_BYTE, all.data(), sizes.data(), offsets.data(), MPI_BYTE, comm);
     return all;
+  }
+
+  /// @p values (@p n) summed over the ranks of @p comm, reduced on rank 0 and broadcast: the
+  /// same bits on every rank (an all-reduce may add in a different order on each). Collective.
+  inline void sum_with_the_same_bits(double *values, std::size_t n, MPI_Comm comm)
+  {
+    const int count = static_cast<int>(n);
+    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      MPI_Reduce(MPI_IN_PLACE, values, count, MPI_DOUBLE, MPI_SUM, 0, comm);
+    else
+      MPI_Reduce(values, nullptr, count, MPI_DOUBLE, MPI_SUM, 0, comm);
+    MPI_Bcast(values, count, MPI_DOUBLE, 0, comm);
   }
 } // namespace tribo::dem::parallel

@@ -82,12 +82,7 @@ namespace tribo::dem::parallel
 
   void BandSplit::sum(double *values, std::size_t n) const
   {
-    const int count = static_cast<int>(n);
-    if (rank == 0)
-      MPI_Reduce(MPI_IN_PLACE, values, count, MPI_DOUBLE, MPI_SUM, 0, comm);
-    else
-      MPI_Reduce(values, nullptr, count, MPI_DOUBLE, MPI_SUM, 0, comm);
-    MPI_Bcast(values, count, MPI_DOUBLE, 0, comm);
+    sum_with_the_same_bits(values, n, comm);
   }
 
   void BandSplit::min(double *values, std::size_t n) const

@@ -52,7 +52,7 @@ namespace tribo::dem::parallel
           }
         const double y = system.bodies[b].position.y();
         owner_of[b]    = bands.band_of(y);
-        held_flag[b]   = owner_of[b] == rank || (y >= bands.cut[rank] - margin && y < bands.cut[rank + 1] + margin);
+        held_flag[b]   = in_widened_band(y);
       }
     number(system);
   }
@@ -98,7 +98,7 @@ namespace tribo::dem::parallel
     const auto place = [&](unsigned int b) {
       const double y = system.bodies[b].position.y();
       owner_of[b]    = bands.band_of(y);
-      held_flag[b]   = owner_of[b] == rank || (y >= bands.cut[rank] - margin && y < bands.cut[rank + 1] + margin);
+      held_flag[b]   = in_widened_band(y);
     };
     for (const unsigned int b : held_bodies)
       if (grain[b])
@@ -163,12 +163,7 @@ namespace tribo::dem::parallel
     for (const auto &[from, entries] : dealii::Utilities::MPI::some_to_some(comm, out))
       for (std::size_t i = 0; i + 4 <= entries.size(); i += 4)
         per_body[static_cast<unsigned int>(entries[i])] += Eigen::Vector3d(entries[i + 1], entries[i + 2], entries[i + 3]);
-    const int count = static_cast<int>(replicated.size());
-    if (rank == 0)
-      MPI_Reduce(MPI_IN_PLACE, replicated.data(), count, MPI_DOUBLE, MPI_SUM, 0, comm);
-    else
-      MPI_Reduce(replicated.data(), nullptr, count, MPI_DOUBLE, MPI_SUM, 0, comm);
-    MPI_Bcast(replicated.data(), count, MPI_DOUBLE, 0, comm);
+    sum_with_the_same_bits(replicated.data(), replicated.size(), comm);
     std::size_t k = 0;
     for (const unsigned int b : held_bodies)
       if (!grain[b])

@@ -3,10 +3,10 @@
 /// over them (dem/parallel/README.md): a rank owns the grains whose centre lies in its band,
 /// holds as ghosts the grains whose centre lies within a margin of its band, and the walls
 /// (clumps: a few degrees of freedom) are replicated. Each rank advances only what it owns;
-/// exchange() then sends the owners' states to the ranks that hold them as ghosts, and a
-/// grain that crossed into another band, that band's ghost until then, is owned there
-/// (migration: no grain lost or held twice as owned). Not yet used by runs, which still hold
-/// and advance the whole state on every rank (docs/scaling.md, "Not yet").
+/// send_states() then sends the owners' states to the ranks that hold them as ghosts, and
+/// once the step stands (settle()) a grain that crossed into another band, that band's ghost
+/// until then, is owned there (migration: no grain lost or held twice as owned). BandSplit
+/// (dem/parallel/band_split.h) keeps one while a rank holds its share of a case's contacts.
 
 #include "dem/engine/particle_system.h"
 #include "dem/parallel/band_partition.h"
@@ -92,6 +92,12 @@ namespace tribo::dem::parallel
     std::pair<unsigned int, unsigned int> widened_bands(double y) const
     {
       return {bands.band_of(y - margin), bands.band_of(y + margin)};
+    }
+    /// Whether this rank's band widened by the margin holds height @p y (its own band among it).
+    bool in_widened_band(double y) const
+    {
+      const auto [first, last] = widened_bands(y);
+      return first <= rank && rank <= last;
     }
 
   private:

@@ -8,6 +8,7 @@
 #include "dem/laws/law_residual.h"
 #include "dem/solvers/nlgs.h"
 #include "tests/unit/lumped_chain.h"
+#include "tests/unit/ranks.h"
 #include "tests/unit/tall_layer.h"
 #include "core/checkpoint.h"
 
@@ -33,18 +34,6 @@ using namespace tribo::dem::test;
 
 namespace
 {
-  MPI_Comm     world() { return MPI_COMM_WORLD; }
-  unsigned int n_ranks() { return dealii::Utilities::MPI::n_mpi_processes(world()); }
-  unsigned int my_rank() { return dealii::Utilities::MPI::this_mpi_process(world()); }
-
-  /// @p values summed over the ranks.
-  std::vector<double> summed(const std::vector<double> &values)
-  {
-    std::vector<double> sum(values.size());
-    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(values), world(), dealii::ArrayView<double>(sum));
-    return sum;
-  }
-
   /// The velocities of every body of the serial numbering after a distributed solve: each
   /// grain's from its owner, the replicated bodies' from rank 0 (summed over the ranks,
   /// each body written by exactly one).

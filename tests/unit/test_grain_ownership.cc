@@ -4,6 +4,7 @@
 // it owns and exchanges them, its copies of the grains it does not hold made NaN. Every
 // assertion follows the collective calls.
 #include "dem/parallel/grain_ownership.h"
+#include "tests/unit/ranks.h"
 #include "tests/unit/tall_layer.h"
 
 #include <deal.II/base/mpi.h>
@@ -16,20 +17,10 @@
 
 using namespace tribo::dem;
 using namespace tribo::dem::parallel;
+using namespace tribo::dem::test;
 
 namespace
 {
-  MPI_Comm     comm() { return MPI_COMM_WORLD; }
-  unsigned int n_ranks() { return dealii::Utilities::MPI::n_mpi_processes(comm()); }
-  unsigned int my_rank() { return dealii::Utilities::MPI::this_mpi_process(comm()); }
-
-  std::vector<double> summed(const std::vector<double> &values)
-  {
-    std::vector<double> sum(values.size());
-    dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(values), comm(), dealii::ArrayView<double>(sum));
-    return sum;
-  }
-
   /// The reference motion of step @p k: grains left of the middle rise and the others sink
   /// (0.2 um per step, so that they cross the bands), with a jitter of up to 0.05 um and a
   /// turn, the same on every rank.
@@ -76,7 +67,7 @@ TEST(GrainOwnership, NoGrainIsLostOrOwnedTwiceAcrossMigrations)
   const auto widened = [&](double y) { return y >= bands.cut[my_rank()] - margin && y < bands.cut[my_rank() + 1] + margin; };
 
   ParticleSystem local = truth;
-  GrainOwnership own(comm(), margin);
+  GrainOwnership own(world(), margin);
   own.start(local, bands);
   unsigned long migrations = 0, ghosts = 0;
   bool          lost_or_twice = false, stale_held = false, wrong_holding = false, wrong_owner = false,
@@ -158,7 +149,7 @@ TEST(GrainOwnership, NoGrainIsLostOrOwnedTwiceAcrossMigrations)
             wrong_gather = wrong_gather || !same_state(local.bodies[b], truth.bodies[b]);
         }
     }
-  const double all_migrations = dealii::Utilities::MPI::sum(double(migrations), comm());
+  const double all_migrations = dealii::Utilities::MPI::sum(double(migrations), world());
   EXPECT_FALSE(lost_or_twice);
   EXPECT_FALSE(stale_held);
   EXPECT_FALSE(wrong_holding);
