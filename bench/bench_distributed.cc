@@ -109,7 +109,7 @@ int main(int argc, char **argv)
         auto solve_on = [&](MPI_Comm comm, bool operator_form, bool momentum) {
           const unsigned int         ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
           dem::parallel::RankProblem share =
-            dem::parallel::share_of(system, problem, state, dem::parallel::contact_bands(system, problem, ranks),
+            dem::parallel::share_of(system, problem, free, dem::parallel::contact_bands(system, problem, ranks),
                                     dealii::Utilities::MPI::this_mpi_process(comm));
           dem::parallel::DistributedControls controls;
           controls.residual_target = target;
@@ -117,10 +117,14 @@ int main(int argc, char **argv)
           controls.momentum        = momentum;
           dem::parallel::DistributedGaussSeidel gauss_seidel(share, comm);
           dem::parallel::DistributedApgs        apgs_form(share, comm);
+          dem::parallel::DistributedSolver     &solver = operator_form
+                                                            ? static_cast<dem::parallel::DistributedSolver &>(apgs_form)
+                                                            : gauss_seidel;
+          dem::parallel::DistributedReport      warm_exchange;
+          solver.add_impulses(share, warm_exchange); // every rank's warm start on the free state
           MPI_Barrier(comm);
           const auto   t0     = Clock::now();
-          const auto   report = operator_form ? apgs_form.solve(share, mj.law(), controls, p.theta * h)
-                                              : gauss_seidel.solve(share, mj.law(), controls, p.theta * h);
+          const auto   report = solver.solve(share, mj.law(), controls, p.theta * h);
           const double t      = std::chrono::duration<double>(Clock::now() - t0).count();
           return std::make_tuple(report, dealii::Utilities::MPI::max(t, comm),
                                  dealii::Utilities::MPI::sum(double(share.n_ghost), comm));

@@ -21,15 +21,19 @@ namespace tribo::dem::parallel
     public:
       /// @p gap_target (m; 0: none) and @p theta_h (s): with IQS the solve also aims at every
       /// contact's gap violation theta h max(0, -u~_n) at most gap_target, as the serial APGS.
+      /// @p warm_from_others: the other ranks' warm-start impulses' velocity changes on this
+      /// rank's bodies (DistributedSolver::add_impulses), which move b' as an exchange does.
       RankSweeps(RankProblem &p, const ContactLaw &law, GrainExchange &exchange, MPI_Comm comm,
-                 DistributedReport &report, double gap_target, double theta_h);
+                 DistributedReport &report, double gap_target, double theta_h,
+                 const std::vector<Eigen::Vector3d> &warm_from_others);
       /// APGS's projected Gauss-Seidel sweep of @p v in place, the contacts on grains of two
       /// ranks relaxed by @p omega.
       void sweep(Eigen::VectorXd &v, double omega);
       /// Exchange the interface contacts' impulses at @p v: their changes since the last
       /// exchange go on the state, the velocities are exchanged, and what the other ranks
-      /// changed on a shared body dv moves b' of the contacts on it by s_j H_j^T dv.
-      void sync(const Eigen::VectorXd &v);
+      /// changed on a shared body dv moves b' of the contacts on it by s_j H_j^T dv. With
+      /// @p changed (increasing), only those contacts' impulses can have changed since.
+      void sync(const Eigen::VectorXd &v, const std::vector<Eigen::Index> *changed = nullptr);
       /// The map over every rank's contacts at @p v (exchanged), relative to the mean loaded
       /// impulse (or, with none loaded, the largest of the ranks' scales); each contact's
       /// map and gap violation are kept for the polish.
@@ -43,7 +47,7 @@ namespace tribo::dem::parallel
       /// the contacts on grains of two ranks relaxed by @p omega. Then (collective) the
       /// exchange of the interface contacts' impulses and the map again, recomputed only where
       /// it changed: the polished contacts' rows of A', the walls' low-rank rows, the interface
-      /// contacts, into @p map. False, with nothing exchanged or changed, when no rank had
+      /// contacts on a body another rank moved, into @p map. False, with nothing exchanged or changed, when no rank had
       /// anything to polish.
       bool polish(Eigen::VectorXd &y, Eigen::VectorXd &z, double target, double omega, double &map);
       /// Polishes after a check whose map @p map is above @p target (or whose gaps are open), as
@@ -54,7 +58,7 @@ namespace tribo::dem::parallel
       bool polish_to(Eigen::VectorXd &y, Eigen::VectorXd &z, double target, double omega, double &map,
                      Eigen::VectorXd &best, double &best_map);
       /// Every contact's impulse at @p y: the interface contacts' through one more exchange,
-      /// the others' on the grains only this rank holds; the caller's free velocities back.
+      /// the others' on the grains only this rank holds.
       void finish(const Eigen::VectorXd &y);
       /// The scaled warm start, rows per contact.
       const SweepProblem &problem() const { return sweep_problem; }
@@ -69,12 +73,12 @@ namespace tribo::dem::parallel
       std::vector<unsigned int>    shared_list;  ///< their local numbers
       std::vector<Eigen::Index>    interface;    ///< contacts on a shared body, increasing
       std::vector<char>            across;       ///< contacts on a grain of two ranks
-      std::vector<Eigen::Vector2d> caller_u_free; ///< the contacts' free velocities as given
       SweepProblem                 sweep_problem;
       ScaledOperator               op;
       Eigen::VectorXd              b;            ///< b', moved by the other ranks' impulses
       std::vector<Eigen::Vector2d> sent;         ///< each contact's impulse in the state, N s/m
       BodyState                    others;       ///< the other ranks' velocity changes at the last exchange
+      std::vector<char>            moved;        ///< local bodies whose change in others is not zero
       std::vector<Eigen::Vector3d> mine;         ///< the shared bodies' velocities before it
       /// Each contact's map at the last check (N s/m), and the largest of each chunk of
       /// chunk_size consecutive contacts; this rank's loaded impulses' sum (N s/m) and count.
@@ -100,13 +104,14 @@ namespace tribo::dem::parallel
       /// mean_loaded set.
       double reduced_map();
 
-      /// The contacts' free velocities without this rank's warm-start impulses (the caller's
-      /// kept): u_free,j = u_j(state) - (W_local r_warm)_j.
-      std::vector<Contact> &with_local_free_velocities();
+      /// b' of the interface contacts moved by the other ranks' velocity changes on the
+      /// shared bodies, dv in others (moved where not zero): b'_j += s_j H_j^T dv.
+      void add_to_b();
     };
 
     RankSweeps::RankSweeps(RankProblem &p, const ContactLaw &law, GrainExchange &exchange, MPI_Comm comm,
-                           DistributedReport &report, double gap_target, double theta_h)
+                           DistributedReport &report, double gap_target, double theta_h,
+                           const std::vector<Eigen::Vector3d> &warm_from_others)
       : p(p)
       , law(law)
       , exchange(exchange)
@@ -114,7 +119,7 @@ namespace tribo::dem::parallel
       , report(report)
       , shared(p.serial_body.size(), 0)
       , across(p.contacts.size(), 0)
-      , sweep_problem(with_local_free_velocities(), p.state, law)
+      , sweep_problem(p.contacts, p.state, law)
       , op(sweep_problem.scaled)
       , b(sweep_problem.scaled.b)
       , mine(p.serial_body.size())
@@ -153,25 +158,30 @@ namespace tribo::dem::parallel
           across[j] = two_ranks[c.body[0]] || two_ranks[c.body[1]];
           sent.push_back(c.r);
         }
-      others.velocity.assign(n_local, Eigen::Vector3d::Zero());
+      // b' from the contacts' free velocities, with the other ranks' warm start on the shared
+      // bodies: b'_j / s_j = u_j(state after add_impulses) - (W_local r_warm)_j.
+      others.velocity     = warm_from_others;
       others.inverse_mass = p.state.inverse_mass;
       // A boundary body's nodes change on this rank only (it holds all their contacts).
       others.node_velocity = Eigen::VectorXd::Zero(p.state.node_velocity.size());
       others.node_blocks   = p.state.node_blocks;
+      moved.assign(n_local, 0);
+      for (const unsigned int l : shared_list)
+        moved[l] = !others.velocity[l].isZero(0);
+      add_to_b();
     }
 
-    std::vector<Contact> &RankSweeps::with_local_free_velocities()
+    void RankSweeps::add_to_b()
     {
-      BodyState without = p.state;
-      for (const Contact &c : p.contacts)
-        if (c.r.x() != 0 || c.r.y() != 0)
-          without.apply_impulse(c, -c.r);
-      for (Contact &c : p.contacts)
-        {
-          caller_u_free.push_back(c.u_free);
-          c.u_free = without.local_velocity(c);
-        }
-      return p.contacts;
+      const Eigen::Index     w = sweep_problem.width;
+      const Eigen::VectorXd &s = sweep_problem.scaled.inv_root;
+      for (const Eigen::Index j : interface)
+        if (const Contact &c = p.contacts[j]; moved[c.body[0]] || moved[c.body[1]])
+          {
+            const Eigen::Vector2d du = others.local_velocity(c);
+            for (Eigen::Index k = 0; k < w; ++k)
+              b[w * j + k] += s[w * j + k] * du[k];
+          }
     }
 
     void RankSweeps::sweep(Eigen::VectorXd &v, double omega)
@@ -181,29 +191,33 @@ namespace tribo::dem::parallel
         sweep_problem.relax(op, law, b, v, j, nullptr, across[j] ? omega : 1.0);
     }
 
-    void RankSweeps::sync(const Eigen::VectorXd &v)
+    void RankSweeps::sync(const Eigen::VectorXd &v, const std::vector<Eigen::Index> *changed)
     {
       exchange.remember(p.state);
-      for (const Eigen::Index j : interface)
+      const auto put = [&](Eigen::Index j) {
+        const Eigen::Vector2d r = sweep_problem.impulse(v, j), dr = r - sent[j];
+        if (dr.x() != 0 || dr.y() != 0)
+          p.state.apply_impulse(p.contacts[j], dr);
+        sent[j] = r;
+      };
+      if (changed)
         {
-          const Eigen::Vector2d r = sweep_problem.impulse(v, j), dr = r - sent[j];
-          if (dr.x() != 0 || dr.y() != 0)
-            p.state.apply_impulse(p.contacts[j], dr);
-          sent[j] = r;
+          for (const Eigen::Index j : *changed)
+            if (const Contact &c = p.contacts[j]; shared[c.body[0]] || shared[c.body[1]])
+              put(j);
         }
+      else
+        for (const Eigen::Index j : interface)
+          put(j);
       for (const unsigned int l : shared_list)
         mine[l] = p.state.velocity[l];
       exchange.exchange(p.state, report);
       for (const unsigned int l : shared_list)
-        others.velocity[l] = p.state.velocity[l] - mine[l];
-      const Eigen::Index     w = sweep_problem.width;
-      const Eigen::VectorXd &s = sweep_problem.scaled.inv_root;
-      for (const Eigen::Index j : interface)
         {
-          const Eigen::Vector2d du = others.local_velocity(p.contacts[j]);
-          for (Eigen::Index k = 0; k < w; ++k)
-            b[w * j + k] += s[w * j + k] * du[k];
+          others.velocity[l] = p.state.velocity[l] - mine[l];
+          moved[l]           = !others.velocity[l].isZero(0);
         }
+      add_to_b();
     }
 
     double RankSweeps::relative_map(const Eigen::VectorXd &v)
@@ -320,12 +334,14 @@ namespace tribo::dem::parallel
       }
       if (!anyone_polishing)
         return false;
-      sync(y);
+      const std::vector<Eigen::Index> none;
+      sync(y, polishing ? &local : &none);
       if (wall)
         for (const Eigen::Index k : op.low_rank_row_list())
           affect(k / w);
       for (const Eigen::Index j : interface)
-        affect(j);
+        if (const Contact &c = p.contacts[j]; moved[c.body[0]] || moved[c.body[1]])
+          affect(j);
       op.set_vector(y);
       for (const Eigen::Index j : affected_rows)
         {
@@ -390,8 +406,7 @@ namespace tribo::dem::parallel
               if (dr.x() != 0 || dr.y() != 0)
                 p.state.apply_impulse(c, dr);
             }
-          c.r      = sweep_problem.impulse(y, j);
-          c.u_free = caller_u_free[j];
+          c.r = sweep_problem.impulse(y, j);
         }
     }
   } // namespace
@@ -401,7 +416,7 @@ namespace tribo::dem::parallel
   {
     DistributedReport report;
     report.neighbours = exchange.neighbours();
-    RankSweeps             rank(p, law, exchange, comm, report, controls.gap_target, theta_h);
+    RankSweeps             rank(p, law, exchange, comm, report, controls.gap_target, theta_h, warm_from_others);
     const SweepProblem    &problem = rank.problem();
     const Eigen::Index     w = problem.width, rows = w * problem.n_contacts();
 

@@ -4,10 +4,12 @@
 /// sweep through the grains' velocities.
 ///
 /// Each rank assembles the scaled problem of its own contacts (dem/solvers/sweep_problem.h:
-/// y, A' + U'U'^T over the bodies they share, ghosts and walls included, b') with
-///     u_free,j = u_j(state) - (W_local r_warm)_j,
-/// the local velocity of contact j without this rank's warm-start impulses: what every
-/// other rank's contacts put on its ghost grains and on the walls is in b'. A sweep is
+/// y, A' + U'U'^T over the bodies they share, ghosts and walls included, b') from the
+/// contacts' free velocities, b' then moved by s_j H_j^T dv_warm for the contacts on a shared
+/// body: dv_warm, what every other rank's warm-start impulses put on its ghost grains, its
+/// exported grains and the walls (the exchange of DistributedSolver::add_impulses), so that
+/// b'_j / s_j is u_j(state) - (W_local r_warm)_j, the local velocity of contact j without this
+/// rank's warm-start impulses. A sweep is
 /// APGS's projected Gauss-Seidel sweep over the rank's contacts (SweepProblem::relax, the
 /// walls' low-rank part kept current in place). After it, the contacts that touch a shared
 /// body (a ghost, an exported grain, a wall with a free degree of freedom) put their impulse

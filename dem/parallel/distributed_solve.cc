@@ -111,7 +111,10 @@ namespace tribo::dem::parallel
     for (const Contact &c : p.contacts)
       if (c.r.x() != 0 || c.r.y() != 0)
         p.state.apply_impulse(c, c.r);
+    warm_from_others = p.state.velocity;
     exchange.exchange(p.state, report);
+    for (std::size_t l = 0; l < warm_from_others.size(); ++l)
+      warm_from_others[l] = p.state.velocity[l] - warm_from_others[l];
   }
 
   bool global_law_residual(const RankProblem &p, const ContactLaw &law, double theta_h, double target,

@@ -142,22 +142,26 @@ namespace tribo::dem::parallel
     DistributedSolver(const RankProblem &problem, MPI_Comm comm)
       : exchange(problem, comm)
       , comm(comm)
+      , warm_from_others(problem.serial_body.size(), Eigen::Vector3d::Zero())
     {}
     virtual ~DistributedSolver() = default;
-    /// Solve @p problem's contacts (warm-started from their impulses, whose effect must be
-    /// in its state) under @p law; @p theta_h turns velocity violations into gap violations.
+    /// Solve @p problem's contacts (warm-started from their impulses, put on its state by
+    /// add_impulses(); a cold start needs none) under @p law; @p theta_h turns velocity violations into gap violations.
     /// Collective; every rank returns the same report, and its owned and ghost velocities
     /// agree with their owners' after the last exchange.
     virtual DistributedReport solve(RankProblem &problem, const ContactLaw &law, const DistributedControls &controls,
                                     double theta_h) = 0;
     /// Collective: from a state of free velocities on every rank, @p problem's state with
     /// every rank's contact impulses (a warm start) on it, as solve() wants: each rank puts
-    /// its own contacts' impulses on its bodies, then one exchange.
+    /// its own contacts' impulses on its bodies, then one exchange. What that exchange
+    /// brought, the other ranks' warm-start impulses' velocity changes on the shared bodies
+    /// (zero on the others), is kept in warm_from_others.
     void add_impulses(RankProblem &problem, DistributedReport &report);
 
   protected:
-    GrainExchange exchange;
-    MPI_Comm      comm;
+    GrainExchange                exchange;
+    MPI_Comm                     comm;
+    std::vector<Eigen::Vector3d> warm_from_others; ///< per local body, m/s and rad/s
   };
 
   /// Collective: the law residual (dem/laws/law_residual.h) over every rank's contacts of

@@ -110,8 +110,9 @@ namespace tribo::dem::parallel
               ghosts.push_back(b);
         }
       const auto by_global = [&](unsigned int a, unsigned int b) { return global(a) < global(b); };
-      std::sort(owned.begin(), owned.end(), by_global);
-      std::sort(ghosts.begin(), ghosts.end(), by_global);
+      for (auto *list : {&owned, &ghosts}) // an ownership's owned grains come sorted
+        if (!std::is_sorted(list->begin(), list->end(), by_global))
+          std::sort(list->begin(), list->end(), by_global);
       p.n_owned = static_cast<unsigned int>(owned.size());
       p.n_ghost = static_cast<unsigned int>(ghosts.size());
       for (const auto *list : {&owned, &ghosts, &replicated})

@@ -45,7 +45,8 @@ namespace tribo::dem::test
   }
 
   /// The contacts of tall_layer() after 20 steps, with their impulses reset (a cold
-  /// start: the sweeps have real work to do), and the state they act on.
+  /// start: the sweeps have real work to do), and the state they act on,
+  /// BodyState::of(system): their free velocities are that state's.
   struct ColdStart
   {
     ParticleSystem       system;
@@ -61,9 +62,13 @@ namespace tribo::dem::test
       MoreauJean mj(0.5, law, prm, 5e-8);
       for (int i = 0; i < 20; ++i)
         mj.step(system, 1e-9);
-      contacts = mj.contacts();
+      contacts              = mj.contacts();
+      const BodyState state = BodyState::of(system);
       for (auto &c : contacts)
-        c.r.setZero();
+        {
+          c.r.setZero();
+          c.u_free = state.local_velocity(c);
+        }
     }
   };
 
