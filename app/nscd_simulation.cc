@@ -8,6 +8,8 @@
 #include "dem/parallel/solve_across_ranks.h"
 #include "dem/solvers/methods.h"
 
+#include <deal.II/base/mpi.h>
+
 #include <boost/archive/binary_iarchive.hpp>
 #include <boost/archive/binary_oarchive.hpp>
 #include <boost/serialization/vector.hpp>
@@ -406,8 +408,15 @@ namespace tribo::app
           summary.set("timing", t);
         }
         summary.set("setup_time", setup_time);
-        summary.set("setup_peak_memory", setup_memory);
-        summary.set("peak_memory", peak_memory_mb());
+        {
+          // On N ranks, the largest rank's.
+          const double here[2] = {setup_memory, peak_memory_mb()};
+          double       largest[2] = {here[0], here[1]};
+          if (split)
+            dealii::Utilities::MPI::max(here, prm.ranks, largest);
+          summary.set("setup_peak_memory", largest[0]);
+          summary.set("peak_memory", largest[1]);
+        }
         if (!end.statistics.rows().empty())
           {
             scene->summarize(world, end.statistics, out.results);
