@@ -52,7 +52,8 @@ namespace tribo::dem::parallel
 
     const auto                         start   = std::chrono::steady_clock::now();
     const unsigned int                 rank    = dealii::Utilities::MPI::this_mpi_process(comm);
-    RankProblem                        problem = own_share(system, contacts, state, split->bands(), rank, split->grain_ownership());
+    RankProblem                        problem =
+      own_share(system, contacts, state, split->bands(), rank, split->grain_ownership());
     const bool                         nlgs    = prm.method == SolverParameters::Method::nlgs;
     std::unique_ptr<DistributedSolver> sweeps;
     if (nlgs)

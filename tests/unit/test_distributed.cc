@@ -397,9 +397,9 @@ namespace
     many.make_whole(split_system);
     ParticleSystem serial = split_system;
     // A rank reads nothing of the grains it does not hold (their copies are stale in a run):
-    // moved a metre up here, the split step must still be the serial one. (The solve once
-    // numbered the grains band by band from every copy: a grain crossing between two other
-    // ranks' bands shifted a rank's numbers, and its ghosts took other grains' velocities.)
+    // moved a metre up here, the split step must still be the serial one. A solve numbering
+    // the grains band by band from every copy, not from the ownership, fails this on 3 and 4
+    // ranks: its ghosts take other grains' velocities.
     if (split->held())
       for (std::size_t b = 0; b < split_system.bodies.size(); ++b)
         if (!split->holds(static_cast<unsigned int>(b)))
